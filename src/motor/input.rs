@@ -1,0 +1,55 @@
+//! The voltage that drives the motor.
+
+use serde::{Deserialize, Serialize};
+
+/// The input voltage: the model's constant `U`, or a recorded series held between samples.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
+pub enum VoltageInput {
+    /// The model parameter `U` throughout.
+    #[default]
+    Constant,
+    /// Zero-order hold: the value at `times[i]` holds on `[times[i], times[i+1])`, and the first
+    /// value also before `times[0]`.
+    Held { times: Vec<f64>, values: Vec<f64> },
+}
+
+impl VoltageInput {
+    /// The held value at time `t`, or `None` for a constant input.
+    pub fn value_at(&self, t: f64) -> Option<f64> {
+        match self {
+            VoltageInput::Constant => None,
+            VoltageInput::Held { times, values } => {
+                let after = times.partition_point(|&ti| ti <= t);
+                Some(values[after.saturating_sub(1)])
+            }
+        }
+    }
+
+    /// Times at which the held value actually changes (not every sample: stopping the
+    /// integrator there would cost a restart for nothing).
+    pub fn breakpoints(&self) -> Vec<f64> {
+        match self {
+            VoltageInput::Constant => Vec::new(),
+            VoltageInput::Held { times, values } => (1..times.len())
+                .filter(|&i| values[i] != values[i - 1])
+                .map(|i| times[i])
+                .collect(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn held_voltage_changes_only_at_its_breakpoints() {
+        let input = VoltageInput::Held { times: vec![0.1, 0.2, 0.3, 0.4], values: vec![24.0, 24.0, 8.0, -24.0] };
+        assert_eq!(input.breakpoints(), vec![0.3, 0.4]);
+        assert_eq!(input.value_at(0.0), Some(24.0));
+        assert_eq!(input.value_at(0.3), Some(8.0));
+        assert_eq!(input.value_at(0.35), Some(8.0));
+        assert_eq!(input.value_at(0.5), Some(-24.0));
+        assert_eq!(VoltageInput::Constant.value_at(0.2), None);
+    }
+}
