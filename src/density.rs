@@ -1,0 +1,126 @@
+//! The one interface every sampler and the optimiser are generic over: a log density on ℝᵈ
+//! (unconstrained coordinates) with its gradient written into a buffer the caller owns.
+
+use std::ops::Range;
+
+use nalgebra::DMatrix;
+
+/// A failed evaluation. Recoverable failures (an ODE that blew up, a step cap reached) reject
+/// the proposal like a divergence; fatal ones stop the run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DensityError {
+    pub recoverable: bool,
+    pub message: String,
+}
+
+impl DensityError {
+    pub fn recoverable(message: impl Into<String>) -> Self {
+        Self { recoverable: true, message: message.into() }
+    }
+    pub fn fatal(message: impl Into<String>) -> Self {
+        Self { recoverable: false, message: message.into() }
+    }
+}
+
+impl std::fmt::Display for DensityError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+impl std::error::Error for DensityError {}
+
+/// An unnormalised log density. `&mut self` lets an implementation keep scratch space and
+/// caches (the motor posterior reuses G(θ) while only noise or discrepancy parameters move).
+/// A point outside the support returns `Ok(f64::NEG_INFINITY)`.
+pub trait LogDensity {
+    fn dim(&self) -> usize;
+
+    /// Names of the unconstrained coordinates.
+    fn parameter_names(&self) -> Vec<String>;
+
+    fn log_density(&mut self, x: &[f64]) -> Result<f64, DensityError>;
+
+    /// The log density, with its gradient written into `grad` (length `dim()`).
+    fn log_density_and_gradient(&mut self, x: &[f64], grad: &mut [f64]) -> Result<f64, DensityError>;
+
+    /// Names of the quantities reported in draws (constrained: σ rather than log σ).
+    fn output_names(&self) -> Vec<String> {
+        self.parameter_names()
+    }
+
+    /// Maps an unconstrained point to the reported quantities.
+    fn constrain(&self, x: &[f64], out: &mut Vec<f64>) {
+        out.clear();
+        out.extend_from_slice(x);
+    }
+
+    /// Groups of coordinates that a variable-at-a-time sampler proposes together.
+    fn blocks(&self) -> Vec<Range<usize>> {
+        (0..self.dim()).map(|i| i..i + 1).collect()
+    }
+}
+
+/// A log density that also offers a positive-definite metric: the expected Fisher information
+/// plus the prior's curvature (the Gauss–Newton approximation of the negative Hessian).
+pub trait FisherMetric: LogDensity {
+    fn fisher_metric(&mut self, x: &[f64], metric: &mut DMatrix<f64>) -> Result<(), DensityError>;
+
+    /// A closer approximation of −∇² log π where one is cheap (e.g. exact in the noise scales);
+    /// the metric by default. Not guaranteed positive definite away from the mode.
+    fn observed_information(&mut self, x: &[f64], out: &mut DMatrix<f64>) -> Result<(), DensityError> {
+        self.fisher_metric(x, out)
+    }
+}
+
+/// Counts evaluations, so that ESS per gradient is measured, not guessed.
+#[derive(Clone, Debug)]
+pub struct Counted<P> {
+    pub inner: P,
+    pub density_evaluations: u64,
+    pub gradient_evaluations: u64,
+    pub metric_evaluations: u64,
+}
+
+impl<P> Counted<P> {
+    pub fn new(inner: P) -> Self {
+        Self { inner, density_evaluations: 0, gradient_evaluations: 0, metric_evaluations: 0 }
+    }
+}
+
+impl<P: LogDensity> LogDensity for Counted<P> {
+    fn dim(&self) -> usize {
+        self.inner.dim()
+    }
+    fn parameter_names(&self) -> Vec<String> {
+        self.inner.parameter_names()
+    }
+    fn log_density(&mut self, x: &[f64]) -> Result<f64, DensityError> {
+        self.density_evaluations += 1;
+        self.inner.log_density(x)
+    }
+    fn log_density_and_gradient(&mut self, x: &[f64], grad: &mut [f64]) -> Result<f64, DensityError> {
+        self.gradient_evaluations += 1;
+        self.inner.log_density_and_gradient(x, grad)
+    }
+    fn output_names(&self) -> Vec<String> {
+        self.inner.output_names()
+    }
+    fn constrain(&self, x: &[f64], out: &mut Vec<f64>) {
+        self.inner.constrain(x, out)
+    }
+    fn blocks(&self) -> Vec<Range<usize>> {
+        self.inner.blocks()
+    }
+}
+
+impl<P: FisherMetric> FisherMetric for Counted<P> {
+    fn fisher_metric(&mut self, x: &[f64], metric: &mut DMatrix<f64>) -> Result<(), DensityError> {
+        self.metric_evaluations += 1;
+        self.inner.fisher_metric(x, metric)
+    }
+    fn observed_information(&mut self, x: &[f64], out: &mut DMatrix<f64>) -> Result<(), DensityError> {
+        self.metric_evaluations += 1;
+        self.inner.observed_information(x, out)
+    }
+}
