@@ -1,0 +1,270 @@
+//! The driver: warm-up then sampling for any kernel and adaptation, one chain or several in
+//! parallel, with per-chain random streams so that draws do not depend on the thread count.
+
+use std::time::{Duration, Instant};
+
+use indicatif::ProgressBar;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use super::{Adaptation, Info, Kernel, State};
+use crate::density::{Counted, DensityError, LogDensity};
+
+/// How long a chain runs and what it keeps.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ChainSettings {
+    /// Warm-up (tuning) transitions, discarded.
+    pub warmup: usize,
+    /// Transitions after warm-up.
+    pub draws: usize,
+    /// Keep only the last `keep` of the draws (the paper's protocol discards an early part of
+    /// the post-tuning draws too); all when `None`.
+    pub keep: Option<usize>,
+}
+
+impl Default for ChainSettings {
+    fn default() -> Self {
+        Self { warmup: 1000, draws: 1000, keep: None }
+    }
+}
+
+impl ChainSettings {
+    pub fn validate(&self) -> Result<(), String> {
+        if self.draws == 0 {
+            return Err("the number of draws must be at least 1".into());
+        }
+        if let Some(keep) = self.keep {
+            if keep == 0 || keep > self.draws {
+                return Err(format!("cannot keep {keep} draws of {} drawn", self.draws));
+            }
+        }
+        Ok(())
+    }
+
+    pub fn kept(&self) -> usize {
+        self.keep.unwrap_or(self.draws)
+    }
+}
+
+/// The sampler columns of one kept draw (CmdStan's `lp__` … `energy__`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct DrawRecord {
+    pub lp: f64,
+    pub accept_stat: f64,
+    pub step_size: f64,
+    pub tree_depth: u32,
+    pub n_steps: u32,
+    pub divergent: bool,
+    pub energy: f64,
+}
+
+/// Everything a chain produced.
+#[derive(Clone, Debug, Serialize)]
+pub struct ChainOutput {
+    pub chain: usize,
+    pub sampler: String,
+    /// Names of the reported (constrained) quantities.
+    pub names: Vec<String>,
+    /// Kept draws, constrained: `draws[i][j]` is quantity j at kept draw i.
+    pub draws: Vec<Vec<f64>>,
+    /// Kept draws in the sampler's unconstrained coordinates.
+    pub unconstrained: Vec<Vec<f64>>,
+    pub records: Vec<DrawRecord>,
+    pub warmup_seconds: f64,
+    pub sampling_seconds: f64,
+    pub warmup_density_evaluations: u64,
+    pub warmup_gradient_evaluations: u64,
+    /// Evaluations during the sampling phase (all draws, kept or not).
+    pub sampling_density_evaluations: u64,
+    pub sampling_gradient_evaluations: u64,
+    pub uses_gradient: bool,
+    pub divergences: usize,
+    /// Mean accept_stat over the sampling phase.
+    pub mean_accept_stat: f64,
+    /// The step size (or proposal scale) the kernel ended with.
+    pub final_step_size: f64,
+}
+
+impl ChainOutput {
+    /// Draws of quantity `j` over the kept draws.
+    pub fn column(&self, j: usize) -> Vec<f64> {
+        self.draws.iter().map(|d| d[j]).collect()
+    }
+}
+
+/// Runs one chain: `settings.warmup` transitions with adaptation, then `settings.draws`
+/// with the kernel frozen.
+pub fn run_chain<P, K, A>(
+    density: P,
+    mut kernel: K,
+    mut adaptation: A,
+    init: &[f64],
+    settings: &ChainSettings,
+    rng: &mut ChaCha8Rng,
+    chain: usize,
+    progress: Option<&ProgressBar>,
+) -> Result<(ChainOutput, K), DensityError>
+where
+    P: LogDensity,
+    K: Kernel<Counted<P>>,
+    A: Adaptation<K>,
+{
+    settings.validate().map_err(DensityError::fatal)?;
+    let mut density = Counted::new(density);
+    let names = density.output_names();
+    let mut state: State = kernel.init_state(&mut density, init)?;
+    if !state.log_density.is_finite() {
+        return Err(DensityError::fatal(format!("chain {chain}: the initial point has zero density")));
+    }
+    let total = settings.warmup + settings.draws;
+    let reporter = Reporter::new(progress, total);
+
+    let started = Instant::now();
+    let mut divergences_warmup = 0usize;
+    for iteration in 0..settings.warmup {
+        let info = kernel.step(&mut density, &mut state, rng)?;
+        divergences_warmup += info.divergent as usize;
+        adaptation.observe(&mut kernel, &state, &info, iteration, settings.warmup);
+        reporter.tick(iteration, &info, divergences_warmup, "warm-up");
+    }
+    adaptation.finish(&mut kernel);
+    let warmup_seconds = started.elapsed().as_secs_f64();
+    let (warmup_density_evaluations, warmup_gradient_evaluations) =
+        (density.density_evaluations, density.gradient_evaluations);
+
+    let first_kept = settings.draws - settings.kept();
+    let mut draws = Vec::with_capacity(settings.kept());
+    let mut unconstrained = Vec::with_capacity(settings.kept());
+    let mut records = Vec::with_capacity(settings.kept());
+    let mut divergences = 0usize;
+    let mut accept_sum = 0.0;
+    let mut constrained = Vec::new();
+    let mut last_step_size = f64::NAN;
+    let sampling_started = Instant::now();
+    for i in 0..settings.draws {
+        let info = kernel.step(&mut density, &mut state, rng)?;
+        divergences += info.divergent as usize;
+        accept_sum += info.accept_stat;
+        last_step_size = info.step_size;
+        if i >= first_kept {
+            density.constrain(&state.x, &mut constrained);
+            draws.push(constrained.clone());
+            unconstrained.push(state.x.clone());
+            records.push(DrawRecord {
+                lp: state.log_density,
+                accept_stat: info.accept_stat,
+                step_size: info.step_size,
+                tree_depth: info.tree_depth,
+                n_steps: info.n_steps,
+                divergent: info.divergent,
+                energy: info.energy,
+            });
+        }
+        reporter.tick(settings.warmup + i, &info, divergences, "sampling");
+    }
+    let sampling_seconds = sampling_started.elapsed().as_secs_f64();
+    reporter.finish(divergences);
+    let output = ChainOutput {
+        chain,
+        sampler: kernel.name(),
+        names,
+        draws,
+        unconstrained,
+        records,
+        warmup_seconds,
+        sampling_seconds,
+        warmup_density_evaluations,
+        warmup_gradient_evaluations,
+        sampling_density_evaluations: density.density_evaluations - warmup_density_evaluations,
+        sampling_gradient_evaluations: density.gradient_evaluations - warmup_gradient_evaluations,
+        uses_gradient: kernel.uses_gradient(),
+        divergences,
+        mean_accept_stat: accept_sum / settings.draws as f64,
+        final_step_size: last_step_size,
+    };
+    Ok((output, kernel))
+}
+
+/// The random stream of chain `chain` under master seed `seed`: independent of which thread
+/// runs the chain and of how many chains run.
+pub fn chain_rng(seed: u64, chain: usize) -> ChaCha8Rng {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    rng.set_stream(chain as u64 + 1);
+    rng
+}
+
+/// Runs one chain per initial point in parallel on the current rayon pool. `make` builds the
+/// density, kernel and adaptation of a chain from its index (each chain owns its density, so
+/// caches and scratch space are never shared).
+pub fn run_chains<P, K, A, F>(
+    inits: &[Vec<f64>],
+    settings: &ChainSettings,
+    seed: u64,
+    make: F,
+    progress: Option<&[ProgressBar]>,
+) -> Result<Vec<(ChainOutput, K)>, DensityError>
+where
+    P: LogDensity,
+    K: Kernel<Counted<P>> + Send,
+    A: Adaptation<K>,
+    F: Fn(usize) -> Result<(P, K, A), DensityError> + Sync,
+{
+    inits
+        .par_iter()
+        .enumerate()
+        .map(|(chain, init)| {
+            let (density, kernel, adaptation) = make(chain)?;
+            let mut rng = chain_rng(seed, chain);
+            let bar = progress.and_then(|bars| bars.get(chain));
+            run_chain(density, kernel, adaptation, init, settings, &mut rng, chain, bar)
+        })
+        .collect()
+}
+
+/// Updates a progress bar at most ~10 times a second, with the chain's health in the message.
+struct Reporter<'a> {
+    bar: Option<&'a ProgressBar>,
+    last: std::cell::Cell<Instant>,
+    accepted: std::cell::Cell<(u64, u64)>,
+}
+
+impl<'a> Reporter<'a> {
+    fn new(bar: Option<&'a ProgressBar>, total: usize) -> Self {
+        if let Some(b) = bar {
+            b.set_length(total as u64);
+            b.set_position(0);
+        }
+        Self { bar, last: std::cell::Cell::new(Instant::now()), accepted: std::cell::Cell::new((0, 0)) }
+    }
+
+    fn tick(&self, iteration: usize, info: &Info, divergences: usize, phase: &str) {
+        let Some(bar) = self.bar else { return };
+        let (acc, n) = self.accepted.get();
+        self.accepted.set((acc + (info.accept_stat * 1000.0) as u64, n + 1));
+        if self.last.get().elapsed() < Duration::from_millis(100) {
+            return;
+        }
+        self.last.set(Instant::now());
+        let (acc, n) = self.accepted.get();
+        bar.set_position(iteration as u64 + 1);
+        bar.set_message(format!(
+            "{phase}  accept {:.2}  step {:.2e}  divergences {divergences}",
+            acc as f64 / 1000.0 / n.max(1) as f64,
+            info.step_size
+        ));
+    }
+
+    fn finish(&self, divergences: usize) {
+        if let Some(bar) = self.bar {
+            let (acc, n) = self.accepted.get();
+            bar.set_position(bar.length().unwrap_or(0));
+            bar.finish_with_message(format!(
+                "done  accept {:.2}  divergences {divergences}",
+                acc as f64 / 1000.0 / n.max(1) as f64
+            ));
+        }
+    }
+}

@@ -1,0 +1,110 @@
+//! Targets with known moments, on which every sampler is tested.
+
+use nalgebra::{DMatrix, DVector};
+
+use crate::density::{DensityError, FisherMetric, LogDensity};
+
+/// N(mean, covariance) in any dimension.
+#[derive(Clone, Debug)]
+pub struct Gaussian {
+    pub mean: DVector<f64>,
+    pub covariance: DMatrix<f64>,
+    precision: DMatrix<f64>,
+    log_normaliser: f64,
+}
+
+impl Gaussian {
+    pub fn new(mean: Vec<f64>, covariance: DMatrix<f64>) -> Self {
+        let d = mean.len();
+        let chol = covariance.clone().cholesky().expect("covariance must be positive definite");
+        let log_det: f64 = 2.0 * chol.l().diagonal().iter().map(|v| v.ln()).sum::<f64>();
+        let precision = chol.inverse();
+        Self {
+            mean: DVector::from_vec(mean),
+            covariance,
+            precision,
+            log_normaliser: -0.5 * (d as f64 * (2.0 * std::f64::consts::PI).ln() + log_det),
+        }
+    }
+
+    /// A correlated Gaussian with standard deviations spanning `scale_ratio` and correlation
+    /// `rho` between neighbours (an AR(1) correlation matrix): a small stand-in for the motor
+    /// posterior's bad conditioning.
+    pub fn correlated(d: usize, rho: f64, scale_ratio: f64) -> Self {
+        let sd: Vec<f64> = (0..d)
+            .map(|i| if d == 1 { 1.0 } else { scale_ratio.powf(i as f64 / (d - 1) as f64) })
+            .collect();
+        let cov = DMatrix::from_fn(d, d, |i, j| sd[i] * sd[j] * rho.powi((i as i32 - j as i32).abs()));
+        let mean = (0..d).map(|i| i as f64 - 0.5 * d as f64).collect();
+        Self::new(mean, cov)
+    }
+
+    pub fn variances(&self) -> Vec<f64> {
+        self.covariance.diagonal().iter().copied().collect()
+    }
+}
+
+impl LogDensity for Gaussian {
+    fn dim(&self) -> usize {
+        self.mean.len()
+    }
+
+    fn parameter_names(&self) -> Vec<String> {
+        (0..self.dim()).map(|i| format!("x.{}", i + 1)).collect()
+    }
+
+    fn log_density(&mut self, x: &[f64]) -> Result<f64, DensityError> {
+        let r = DVector::from_column_slice(x) - &self.mean;
+        Ok(self.log_normaliser - 0.5 * r.dot(&(&self.precision * &r)))
+    }
+
+    fn log_density_and_gradient(&mut self, x: &[f64], grad: &mut [f64]) -> Result<f64, DensityError> {
+        let r = DVector::from_column_slice(x) - &self.mean;
+        let pr = &self.precision * &r;
+        for (g, v) in grad.iter_mut().zip(pr.iter()) {
+            *g = -v;
+        }
+        Ok(self.log_normaliser - 0.5 * r.dot(&pr))
+    }
+}
+
+impl FisherMetric for Gaussian {
+    fn fisher_metric(&mut self, _x: &[f64], metric: &mut DMatrix<f64>) -> Result<(), DensityError> {
+        metric.copy_from(&self.precision);
+        Ok(())
+    }
+}
+
+/// Checks draws against a Gaussian's known moments: every mean within `k` Monte Carlo standard
+/// errors, and every variance within `k` MCSE of the variance estimate (the MCSE of the mean of
+/// the squared deviations, which accounts for autocorrelation). Returns the worst z-scores, or
+/// the first violation.
+pub fn check_gaussian_moments(
+    chains: &[crate::sampler::ChainOutput],
+    target: &Gaussian,
+    k: f64,
+) -> Result<(f64, f64), String> {
+    use crate::diagnostics::mcse_mean;
+    let d = target.mean.len();
+    let variances = target.variances();
+    let (mut worst_mean, mut worst_var) = (0.0f64, 0.0f64);
+    for j in 0..d {
+        let columns: Vec<Vec<f64>> = chains.iter().map(|c| c.column(j)).collect();
+        let n: usize = columns.iter().map(|c| c.len()).sum();
+        let mean = columns.iter().flatten().sum::<f64>() / n as f64;
+        let z_mean = (mean - target.mean[j]) / mcse_mean(&columns);
+        let squares: Vec<Vec<f64>> =
+            columns.iter().map(|c| c.iter().map(|v| (v - target.mean[j]).powi(2)).collect()).collect();
+        let var = squares.iter().flatten().sum::<f64>() / n as f64;
+        let z_var = (var - variances[j]) / mcse_mean(&squares);
+        worst_mean = worst_mean.max(z_mean.abs());
+        worst_var = worst_var.max(z_var.abs());
+        if !(z_mean.abs() <= k) {
+            return Err(format!("mean of x.{} = {mean} vs {} ({z_mean:.2} MCSE)", j + 1, target.mean[j]));
+        }
+        if !(z_var.abs() <= k) {
+            return Err(format!("variance of x.{} = {var} vs {} ({z_var:.2} MCSE)", j + 1, variances[j]));
+        }
+    }
+    Ok((worst_mean, worst_var))
+}
