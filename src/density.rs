@@ -15,10 +15,16 @@ pub struct DensityError {
 
 impl DensityError {
     pub fn recoverable(message: impl Into<String>) -> Self {
-        Self { recoverable: true, message: message.into() }
+        Self {
+            recoverable: true,
+            message: message.into(),
+        }
     }
     pub fn fatal(message: impl Into<String>) -> Self {
-        Self { recoverable: false, message: message.into() }
+        Self {
+            recoverable: false,
+            message: message.into(),
+        }
     }
 }
 
@@ -42,7 +48,11 @@ pub trait LogDensity {
     fn log_density(&mut self, x: &[f64]) -> Result<f64, DensityError>;
 
     /// The log density, with its gradient written into `grad` (length `dim()`).
-    fn log_density_and_gradient(&mut self, x: &[f64], grad: &mut [f64]) -> Result<f64, DensityError>;
+    fn log_density_and_gradient(
+        &mut self,
+        x: &[f64],
+        grad: &mut [f64],
+    ) -> Result<f64, DensityError>;
 
     /// Names of the quantities reported in draws (constrained: σ rather than log σ).
     fn output_names(&self) -> Vec<String> {
@@ -68,7 +78,11 @@ pub trait FisherMetric: LogDensity {
 
     /// A closer approximation of −∇² log π where one is cheap (e.g. exact in the noise scales);
     /// the metric by default. Not guaranteed positive definite away from the mode.
-    fn observed_information(&mut self, x: &[f64], out: &mut DMatrix<f64>) -> Result<(), DensityError> {
+    fn observed_information(
+        &mut self,
+        x: &[f64],
+        out: &mut DMatrix<f64>,
+    ) -> Result<(), DensityError> {
         self.fisher_metric(x, out)
     }
 }
@@ -84,7 +98,12 @@ pub struct Counted<P> {
 
 impl<P> Counted<P> {
     pub fn new(inner: P) -> Self {
-        Self { inner, density_evaluations: 0, gradient_evaluations: 0, metric_evaluations: 0 }
+        Self {
+            inner,
+            density_evaluations: 0,
+            gradient_evaluations: 0,
+            metric_evaluations: 0,
+        }
     }
 }
 
@@ -99,7 +118,11 @@ impl<P: LogDensity> LogDensity for Counted<P> {
         self.density_evaluations += 1;
         self.inner.log_density(x)
     }
-    fn log_density_and_gradient(&mut self, x: &[f64], grad: &mut [f64]) -> Result<f64, DensityError> {
+    fn log_density_and_gradient(
+        &mut self,
+        x: &[f64],
+        grad: &mut [f64],
+    ) -> Result<f64, DensityError> {
         self.gradient_evaluations += 1;
         self.inner.log_density_and_gradient(x, grad)
     }
@@ -119,7 +142,11 @@ impl<P: FisherMetric> FisherMetric for Counted<P> {
         self.metric_evaluations += 1;
         self.inner.fisher_metric(x, metric)
     }
-    fn observed_information(&mut self, x: &[f64], out: &mut DMatrix<f64>) -> Result<(), DensityError> {
+    fn observed_information(
+        &mut self,
+        x: &[f64],
+        out: &mut DMatrix<f64>,
+    ) -> Result<(), DensityError> {
         self.metric_evaluations += 1;
         self.inner.observed_information(x, out)
     }

@@ -39,13 +39,23 @@ impl ForwardModel {
             .iter()
             .map(|name| {
                 model.parameter_index(name).ok_or_else(|| {
-                    format!("unknown parameter '{name}' (known: {})", model.parameter_names().join(", "))
+                    format!(
+                        "unknown parameter '{name}' (known: {})",
+                        model.parameter_names().join(", ")
+                    )
                 })
             })
             .collect::<Result<Vec<_>, _>>()?;
         let segments = model.segments(T0);
         let nominal = model.parameter_values();
-        Ok(Self { model, times, segments, calibrated, nominal, solver })
+        Ok(Self {
+            model,
+            times,
+            segments,
+            calibrated,
+            nominal,
+            solver,
+        })
     }
 
     pub fn model(&self) -> &MotorModel {
@@ -119,7 +129,8 @@ impl ForwardModel {
                 let mut stats = SolverStats::default();
                 for start in (0..n_par).step_by(4) {
                     let width = (n_par - start).min(4);
-                    let s = self.sensitivity_pass::<DualSVec64<4>>(theta, start, width, out, jacobian)?;
+                    let s =
+                        self.sensitivity_pass::<DualSVec64<4>>(theta, start, width, out, jacobian)?;
                     stats.accepted_steps += s.accepted_steps;
                     stats.rejected_steps += s.rejected_steps;
                     stats.rhs_evaluations += s.rhs_evaluations;
@@ -156,7 +167,11 @@ impl ForwardModel {
         Ok(stats)
     }
 
-    fn run<D: DualNum<Primitive = f64> + Copy>(&self, p: &[D], out: &mut [D]) -> Result<SolverStats, OdeError> {
+    fn run<D: DualNum<Primitive = f64> + Copy>(
+        &self,
+        p: &[D],
+        out: &mut [D],
+    ) -> Result<SolverStats, OdeError> {
         let n = self.model.n_states();
         let m = self.times.len();
         let n_channels = self.channels().len();
@@ -167,7 +182,8 @@ impl ForwardModel {
         let stats = ode::solve(&system, T0, &y0, &self.times, &self.solver, &mut states)?;
         let mut measured = vec![D::from(0.0); n_channels];
         for i in 0..m {
-            self.model.measure(&states[i * n..(i + 1) * n], p, &mut measured);
+            self.model
+                .measure(&states[i * n..(i + 1) * n], p, &mut measured);
             for c in 0..n_channels {
                 out[c * m + i] = measured[c];
             }

@@ -5,4 +5,19 @@
 //! motor model → integrator → forward model with sensitivities → Bayesian model
 //! (log density + gradient) → samplers → draws → diagnostics → reports.
 
+// `!(a > b)` is how numeric code here says "fails, or is NaN": the negation is the point.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+// Index loops over several parallel arrays read closer to the formulas than zipped iterators.
+#![allow(clippy::needless_range_loop)]
+
+pub mod app;
+pub mod bayes;
+pub mod density;
 pub mod diagnostics;
+pub mod forward;
+pub mod io;
+pub mod motor;
+pub mod ode;
+pub mod optimize;
+pub mod sampler;
+pub mod synthetic;

@@ -51,7 +51,10 @@ pub struct MapSettings {
 
 impl Default for MapSettings {
     fn default() -> Self {
-        Self { max_iterations: 2000, gradient_tolerance: 1e-7 }
+        Self {
+            max_iterations: 2000,
+            gradient_tolerance: 1e-7,
+        }
     }
 }
 
@@ -68,7 +71,11 @@ struct Whitened<'a, P> {
 impl<P: FisherMetric> Whitened<'_, P> {
     fn to_x(&self, z: &[f64]) -> Vec<f64> {
         let dx = &self.transform * DVector::from_column_slice(z);
-        self.origin.iter().zip(dx.iter()).map(|(a, b)| a + b).collect()
+        self.origin
+            .iter()
+            .zip(dx.iter())
+            .map(|(a, b)| a + b)
+            .collect()
     }
 }
 
@@ -99,7 +106,11 @@ impl<P: FisherMetric> Gradient for Whitened<'_, P> {
     fn gradient(&self, z: &Self::Param) -> Result<Vec<f64>, argmin::core::Error> {
         let x = self.to_x(z);
         let mut g = vec![0.0; x.len()];
-        match self.density.borrow_mut().log_density_and_gradient(&x, &mut g) {
+        match self
+            .density
+            .borrow_mut()
+            .log_density_and_gradient(&x, &mut g)
+        {
             Ok(lp) if lp.is_finite() => {}
             Ok(_) => return Ok(vec![0.0; x.len()]),
             Err(e) if e.recoverable => return Ok(vec![0.0; x.len()]),
@@ -111,20 +122,34 @@ impl<P: FisherMetric> Gradient for Whitened<'_, P> {
     }
 }
 
-fn cholesky_factor(metric: &DMatrix<f64>) -> Result<nalgebra::Cholesky<f64, nalgebra::Dyn>, DensityError> {
+fn cholesky_factor(
+    metric: &DMatrix<f64>,
+) -> Result<nalgebra::Cholesky<f64, nalgebra::Dyn>, DensityError> {
     if let Some(ch) = metric.clone().cholesky() {
         return Ok(ch);
     }
     // A tiny ridge for a metric that is singular in some direction the data do not see.
-    let ridge = 1e-10 * metric.diagonal().iter().map(|v| v.abs()).fold(0.0, f64::max).max(1e-300);
+    let ridge = 1e-10
+        * metric
+            .diagonal()
+            .iter()
+            .map(|v| v.abs())
+            .fold(0.0, f64::max)
+            .max(1e-300);
     let n = metric.nrows();
     (metric + DMatrix::from_diagonal_element(n, n, ridge))
         .cholesky()
-        .ok_or_else(|| DensityError::fatal("the metric at the starting point is not positive definite"))
+        .ok_or_else(|| {
+            DensityError::fatal("the metric at the starting point is not positive definite")
+        })
 }
 
 /// Finds the posterior mode from `start`, then the metric and Laplace evidence there.
-pub fn find_map<P: FisherMetric>(density: &mut P, start: &[f64], settings: &MapSettings) -> Result<MapEstimate, DensityError> {
+pub fn find_map<P: FisherMetric>(
+    density: &mut P,
+    start: &[f64],
+    settings: &MapSettings,
+) -> Result<MapEstimate, DensityError> {
     let d = density.dim();
     let mut x0 = start.to_vec();
     let mut iterations = 0;
@@ -133,8 +158,16 @@ pub fn find_map<P: FisherMetric>(density: &mut P, start: &[f64], settings: &MapS
         let mut metric = DMatrix::zeros(d, d);
         density.fisher_metric(&x0, &mut metric)?;
         let chol = cholesky_factor(&metric)?;
-        let l_inv_t = chol.l().transpose().try_inverse().ok_or_else(|| DensityError::fatal("singular metric"))?;
-        let problem = Whitened { density: RefCell::new(&mut *density), origin: x0.clone(), transform: l_inv_t };
+        let l_inv_t = chol
+            .l()
+            .transpose()
+            .try_inverse()
+            .ok_or_else(|| DensityError::fatal("singular metric"))?;
+        let problem = Whitened {
+            density: RefCell::new(&mut *density),
+            origin: x0.clone(),
+            transform: l_inv_t,
+        };
         let linesearch = MoreThuenteLineSearch::new();
         let solver = LBFGS::new(linesearch, 10)
             .with_tolerance_grad(settings.gradient_tolerance)
@@ -145,8 +178,17 @@ pub fn find_map<P: FisherMetric>(density: &mut P, start: &[f64], settings: &MapS
             .run()
             .map_err(|e| DensityError::fatal(format!("MAP search failed: {e}")))?;
         iterations += result.state().get_iter();
-        let z = result.state().get_best_param().cloned().unwrap_or_else(|| vec![0.0; d]);
-        x0 = result.problem.problem.as_ref().expect("problem is returned").to_x(&z);
+        let z = result
+            .state()
+            .get_best_param()
+            .cloned()
+            .unwrap_or_else(|| vec![0.0; d]);
+        x0 = result
+            .problem
+            .problem
+            .as_ref()
+            .expect("problem is returned")
+            .to_x(&z);
     }
     // Gauss–Newton polish: L-BFGS stalls when the cost's change falls below its rounding
     // (the log density is ~10³ at the mode); Newton steps on the gradient do not.
@@ -158,7 +200,10 @@ pub fn find_map<P: FisherMetric>(density: &mut P, start: &[f64], settings: &MapS
         density.fisher_metric(&x0, &mut hessian)?;
         let chol = cholesky_factor(&hessian)?;
         let step = chol.solve(&DVector::from_column_slice(&gradient));
-        newton_decrement = step.dot(&DVector::from_column_slice(&gradient)).max(0.0).sqrt();
+        newton_decrement = step
+            .dot(&DVector::from_column_slice(&gradient))
+            .max(0.0)
+            .sqrt();
         if newton_decrement < 1e-9 {
             break;
         }
@@ -166,7 +211,11 @@ pub fn find_map<P: FisherMetric>(density: &mut P, start: &[f64], settings: &MapS
         let mut improved = false;
         let mut trial_gradient = vec![0.0; d];
         for _ in 0..30 {
-            let trial: Vec<f64> = x0.iter().zip(step.iter()).map(|(a, b)| a + scale * b).collect();
+            let trial: Vec<f64> = x0
+                .iter()
+                .zip(step.iter())
+                .map(|(a, b)| a + scale * b)
+                .collect();
             match density.log_density_and_gradient(&trial, &mut trial_gradient) {
                 Ok(lp) if lp.is_finite() && lp >= log_density => {
                     x0 = trial;
@@ -187,7 +236,9 @@ pub fn find_map<P: FisherMetric>(density: &mut P, start: &[f64], settings: &MapS
         }
     }
     if !log_density.is_finite() {
-        return Err(DensityError::fatal("the MAP search ended outside the support"));
+        return Err(DensityError::fatal(
+            "the MAP search ended outside the support",
+        ));
     }
     // The observed information where it is positive definite (it is at a proper mode), the
     // expected one otherwise.
@@ -201,5 +252,12 @@ pub fn find_map<P: FisherMetric>(density: &mut P, start: &[f64], settings: &MapS
     };
     let log_det: f64 = 2.0 * chol.l().diagonal().iter().map(|v| v.ln()).sum::<f64>();
     let log_evidence_laplace = log_density + 0.5 * d as f64 * LN_2PI - 0.5 * log_det;
-    Ok(MapEstimate { x: x0, log_density, hessian, log_evidence_laplace, iterations, newton_decrement })
+    Ok(MapEstimate {
+        x: x0,
+        log_density,
+        hessian,
+        log_evidence_laplace,
+        iterations,
+        newton_decrement,
+    })
 }

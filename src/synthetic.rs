@@ -21,7 +21,12 @@ pub struct PaperSetup {
 
 impl Default for PaperSetup {
     fn default() -> Self {
-        Self { truth: MotorParameters::default(), noise_sd: [2.0, 10.0], t_end: 0.5, samples: 501 }
+        Self {
+            truth: MotorParameters::default(),
+            noise_sd: [2.0, 10.0],
+            t_end: 0.5,
+            samples: 501,
+        }
     }
 }
 
@@ -30,7 +35,9 @@ pub const DEFAULT_SEED: u64 = 20180823;
 
 /// t_i = i·T/M, i = 1..M (no sample at t = 0).
 pub fn sample_times(t_end: f64, samples: usize) -> Vec<f64> {
-    (1..=samples).map(|i| i as f64 * t_end / samples as f64).collect()
+    (1..=samples)
+        .map(|i| i as f64 * t_end / samples as f64)
+        .collect()
 }
 
 /// Noise-free and measured channels of one synthetic recording.
@@ -61,9 +68,19 @@ impl SyntheticData {
 
 /// Simulates `model` at `times` at the data-generation tolerance and adds N(0, σ_c²) noise to
 /// each channel c, drawing all of channel 0's noise first.
-pub fn generate(model: &MotorModel, times: &[f64], noise_sd: &[f64], seed: u64) -> Result<SyntheticData, OdeError> {
-    let forward = ForwardModel::new(model.clone(), times.to_vec(), &[], SolverSettings::for_data_generation())
-        .map_err(OdeError::BadOutputTimes)?;
+pub fn generate(
+    model: &MotorModel,
+    times: &[f64],
+    noise_sd: &[f64],
+    seed: u64,
+) -> Result<SyntheticData, OdeError> {
+    let forward = ForwardModel::new(
+        model.clone(),
+        times.to_vec(),
+        &[],
+        SolverSettings::for_data_generation(),
+    )
+    .map_err(OdeError::BadOutputTimes)?;
     let mut out = vec![0.0; forward.n_outputs()];
     forward.simulate(&[], &mut out)?;
     let m = times.len();
@@ -89,5 +106,10 @@ pub fn generate(model: &MotorModel, times: &[f64], noise_sd: &[f64], seed: u64) 
 /// The paper's synthetic measurements for a seed.
 pub fn paper_measurements(setup: &PaperSetup, seed: u64) -> Result<SyntheticData, OdeError> {
     let model = MotorModel::new(setup.truth.clone(), VoltageInput::Constant);
-    generate(&model, &sample_times(setup.t_end, setup.samples), &setup.noise_sd, seed)
+    generate(
+        &model,
+        &sample_times(setup.t_end, setup.samples),
+        &setup.noise_sd,
+        seed,
+    )
 }

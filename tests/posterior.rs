@@ -12,9 +12,16 @@ use nalgebra::DMatrix;
 /// The paper's case: data from φ = 1, fitted with the simulation model φ = 0.9 (c_g = 0.009).
 fn paper_posterior(settings: &ModelSettings, seed: u64) -> CalibrationPosterior {
     let data = paper_measurements(&PaperSetup::default(), seed).unwrap();
-    let model = MotorModel::new(MotorParameters::paper_simulation_model(), VoltageInput::Constant);
-    let forward = ForwardModel::new(model, data.times.clone(), &["R"], SolverSettings::default()).unwrap();
-    let obs = Observations { label: "paper".into(), channels: data.measured.clone() };
+    let model = MotorModel::new(
+        MotorParameters::paper_simulation_model(),
+        VoltageInput::Constant,
+    );
+    let forward =
+        ForwardModel::new(model, data.times.clone(), &["R"], SolverSettings::default()).unwrap();
+    let obs = Observations {
+        label: "paper".into(),
+        channels: data.measured.clone(),
+    };
     CalibrationPosterior::new(vec![(forward, obs)], settings).unwrap()
 }
 
@@ -24,7 +31,12 @@ fn relative_gap(a: f64, b: f64) -> f64 {
 
 #[test]
 fn the_full_gradient_matches_central_finite_differences_at_k_0_9_20_and_in_bm1() {
-    for settings in [ModelSettings::bm1(), ModelSettings::bm2(0), ModelSettings::bm2(9), ModelSettings::bm2(20)] {
+    for settings in [
+        ModelSettings::bm1(),
+        ModelSettings::bm2(0),
+        ModelSettings::bm2(9),
+        ModelSettings::bm2(20),
+    ] {
         let mut post = paper_posterior(&settings, 7);
         let mut x = post.initial_point().unwrap();
         // Move off the least-squares start so that every gradient component is sizeable, and
@@ -37,7 +49,11 @@ fn the_full_gradient_matches_central_finite_differences_at_k_0_9_20_and_in_bm1()
         let mut grad = vec![0.0; d];
         let lp = post.log_density_and_gradient(&x, &mut grad).unwrap();
         assert!(lp.is_finite());
-        assert_eq!(lp, post.log_density(&x).unwrap(), "value with and without gradient differ");
+        assert_eq!(
+            lp,
+            post.log_density(&x).unwrap(),
+            "value with and without gradient differ"
+        );
         for i in 0..d {
             let h = 1e-5 * x[i].abs().max(0.1);
             let mut xp = x.clone();
@@ -65,7 +81,10 @@ fn resistance_at_or_below_zero_has_zero_density() {
     assert_eq!(post.log_density(&x).unwrap(), f64::NEG_INFINITY);
     x[0] = -0.05;
     let mut g = vec![0.0; x.len()];
-    assert_eq!(post.log_density_and_gradient(&x, &mut g).unwrap(), f64::NEG_INFINITY);
+    assert_eq!(
+        post.log_density_and_gradient(&x, &mut g).unwrap(),
+        f64::NEG_INFINITY
+    );
 }
 
 #[test]
@@ -97,7 +116,10 @@ fn the_observed_information_is_close_to_the_hessian_at_the_mode() {
     let l_inv = chol.l().try_inverse().unwrap();
     let whitened = &l_inv * &hessian * l_inv.transpose();
     let gap = (&whitened - DMatrix::identity(d, d)).norm() / (d as f64).sqrt();
-    assert!(gap < 0.05, "observed information differs from the Hessian by {gap} (whitened, RMS)");
+    assert!(
+        gap < 0.05,
+        "observed information differs from the Hessian by {gap} (whitened, RMS)"
+    );
 }
 
 #[test]
@@ -110,12 +132,27 @@ fn map_of_bm1_is_biased_and_bm2_removes_most_of_the_bias() {
     let mut bm2 = paper_posterior(&ModelSettings::bm2(9), 11);
     let start = bm2.initial_point().unwrap();
     let map2 = find_map(&mut bm2, &start, &MapSettings::default()).unwrap();
-    eprintln!("BM1 MAP R = {}, σ_I = {}; BM2 MAP R = {}, σ_I = {}", map1.x[0], map1.x[1].exp(), map2.x[0], map2.x[1].exp());
-    assert!(map1.newton_decrement < 1e-6 && map2.newton_decrement < 1e-6, "{} {}", map1.newton_decrement, map2.newton_decrement);
+    eprintln!(
+        "BM1 MAP R = {}, σ_I = {}; BM2 MAP R = {}, σ_I = {}",
+        map1.x[0],
+        map1.x[1].exp(),
+        map2.x[0],
+        map2.x[1].exp()
+    );
+    assert!(
+        map1.newton_decrement < 1e-6 && map2.newton_decrement < 1e-6,
+        "{} {}",
+        map1.newton_decrement,
+        map2.newton_decrement
+    );
     assert!((map1.x[0] - 0.0903).abs() < 0.002, "BM1 R = {}", map1.x[0]);
     assert!(map1.x[1].exp() > 5.0, "BM1 σ_I = {}", map1.x[1].exp());
     assert!((map2.x[0] - 0.1).abs() < 0.004, "BM2 R = {}", map2.x[0]);
-    assert!((map2.x[1].exp() - 2.0).abs() < 0.3, "BM2 σ_I = {}", map2.x[1].exp());
+    assert!(
+        (map2.x[1].exp() - 2.0).abs() < 0.3,
+        "BM2 σ_I = {}",
+        map2.x[1].exp()
+    );
 }
 
 #[test]
@@ -138,11 +175,16 @@ fn laplace_evidence_of_bm1_agrees_with_importance_sampling() {
         let z: Vec<f64> = (0..d).map(|_| StandardNormal.sample(&mut rng)).collect();
         let dx = &l_inv_t * nalgebra::DVector::from_vec(z.clone());
         let x: Vec<f64> = map.x.iter().zip(dx.iter()).map(|(a, b)| a + b).collect();
-        let log_q = -0.5 * z.iter().map(|v| v * v).sum::<f64>() - 0.5 * d as f64 * (2.0 * std::f64::consts::PI).ln() - 0.5 * log_det_cov;
+        let log_q = -0.5 * z.iter().map(|v| v * v).sum::<f64>()
+            - 0.5 * d as f64 * (2.0 * std::f64::consts::PI).ln()
+            - 0.5 * log_det_cov;
         log_w.push(post.log_density(&x).unwrap() - log_q);
     }
     let max = log_w.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
     let log_z = max + (log_w.iter().map(|w| (w - max).exp()).sum::<f64>() / n as f64).ln();
-    eprintln!("log evidence: Laplace {} vs importance sampling {log_z}", map.log_evidence_laplace);
+    eprintln!(
+        "log evidence: Laplace {} vs importance sampling {log_z}",
+        map.log_evidence_laplace
+    );
     assert!((log_z - map.log_evidence_laplace).abs() < 0.1);
 }

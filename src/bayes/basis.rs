@@ -40,10 +40,14 @@ pub const MAX_LEGENDRE_DEGREE: usize = 40;
 impl Legendre {
     pub fn new(degree: usize, t_end: f64) -> Result<Self, String> {
         if degree > MAX_LEGENDRE_DEGREE {
-            return Err(format!("discrepancy degree K = {degree} is larger than the maximum {MAX_LEGENDRE_DEGREE}"));
+            return Err(format!(
+                "discrepancy degree K = {degree} is larger than the maximum {MAX_LEGENDRE_DEGREE}"
+            ));
         }
         if !(t_end > 0.0 && t_end.is_finite()) {
-            return Err(format!("the recording must end after t = 0 (last time {t_end})"));
+            return Err(format!(
+                "the recording must end after t = 0 (last time {t_end})"
+            ));
         }
         Ok(Self { degree, t_end })
     }
@@ -85,7 +89,11 @@ mod tests {
         for j in 0..13 {
             for k in 0..13 {
                 let expected = if j == k { 1.0 } else { 0.0 };
-                assert!((gram[(j, k)] - expected).abs() < 1e-3, "({j},{k}) = {}", gram[(j, k)]);
+                assert!(
+                    (gram[(j, k)] - expected).abs() < 1e-3,
+                    "({j},{k}) = {}",
+                    gram[(j, k)]
+                );
             }
         }
     }

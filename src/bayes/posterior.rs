@@ -72,14 +72,19 @@ impl RecordTerm {
         }
         self.cached = Cached::Nothing;
         let result = if sensitivities {
-            self.forward.simulate_with_sensitivities(theta, &mut self.outputs, &mut self.jacobian)
+            self.forward
+                .simulate_with_sensitivities(theta, &mut self.outputs, &mut self.jacobian)
         } else {
             self.forward.simulate(theta, &mut self.outputs)
         };
         result.map_err(|e| DensityError::recoverable(format!("{}: {e}", self.label)))?;
         self.cached_theta.clear();
         self.cached_theta.extend_from_slice(theta);
-        self.cached = if sensitivities { Cached::WithSensitivities } else { Cached::Values };
+        self.cached = if sensitivities {
+            Cached::WithSensitivities
+        } else {
+            Cached::Values
+        };
         Ok(())
     }
 
@@ -118,10 +123,19 @@ pub struct CalibrationPosterior {
 
 impl CalibrationPosterior {
     /// Builds the posterior. Every record's forward model must calibrate the same parameters.
-    pub fn new(records: Vec<(ForwardModel, Observations)>, settings: &ModelSettings) -> Result<Self, String> {
+    pub fn new(
+        records: Vec<(ForwardModel, Observations)>,
+        settings: &ModelSettings,
+    ) -> Result<Self, String> {
         settings.validate()?;
-        let Some((first, _)) = records.first() else { return Err("no recordings".into()) };
-        let theta_names: Vec<String> = first.calibrated_names().iter().map(|s| s.to_string()).collect();
+        let Some((first, _)) = records.first() else {
+            return Err("no recordings".into());
+        };
+        let theta_names: Vec<String> = first
+            .calibrated_names()
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
         let nominal = first.nominal_calibrated();
         let mut theta_priors = Vec::new();
         let mut theta_positive = Vec::new();
@@ -131,7 +145,10 @@ impl CalibrationPosterior {
             theta_priors.push(settings.resistance_prior(value.abs()));
             theta_positive.push(MotorParam::from_key(name).is_some_and(|p| p.must_be_positive()));
         }
-        let noise_prior = Prior::InverseGamma { shape: settings.noise_prior_shape, scale: settings.noise_prior_scale };
+        let noise_prior = Prior::InverseGamma {
+            shape: settings.noise_prior_shape,
+            scale: settings.noise_prior_scale,
+        };
 
         let several = records.len() > 1;
         let mut names: Vec<String> = theta_names.clone();
@@ -142,7 +159,10 @@ impl CalibrationPosterior {
         let mut pending_coefficients = Vec::new();
         for (r, (forward, obs)) in records.into_iter().enumerate() {
             if forward.calibrated_names() != first_names(&theta_names) {
-                return Err(format!("recording '{}' calibrates other parameters than the first", obs.label));
+                return Err(format!(
+                    "recording '{}' calibrates other parameters than the first",
+                    obs.label
+                ));
             }
             let channel_names = forward.channels();
             if obs.channels.len() != channel_names.len() {
@@ -154,16 +174,29 @@ impl CalibrationPosterior {
                 ));
             }
             let m = forward.n_samples();
-            let suffix = if several { format!("_r{}", r + 1) } else { String::new() };
+            let suffix = if several {
+                format!("_r{}", r + 1)
+            } else {
+                String::new()
+            };
             let mut channels = Vec::new();
             for (name, observed) in channel_names.iter().zip(obs.channels) {
                 if observed.len() != m {
-                    return Err(format!("recording '{}', channel {name}: {} values for {m} times", obs.label, observed.len()));
+                    return Err(format!(
+                        "recording '{}', channel {name}: {} values for {m} times",
+                        obs.label,
+                        observed.len()
+                    ));
                 }
                 names.push(format!("log_sigma_{name}{suffix}"));
                 output_names.push(format!("sigma_{name}{suffix}"));
                 blocks.push(next..next + 1);
-                channels.push(ChannelTerm { name: name.to_string(), observed, log_sigma_index: next, discrepancy: None });
+                channels.push(ChannelTerm {
+                    name: name.to_string(),
+                    observed,
+                    log_sigma_index: next,
+                    discrepancy: None,
+                });
                 next += 1;
             }
             if let Some(k) = settings.discrepancy_degree {
@@ -205,7 +238,9 @@ impl CalibrationPosterior {
                 basis: b,
                 gram,
                 offset: next,
-                priors: (0..n).map(|j| settings.coefficient_prior.prior(j)).collect(),
+                priors: (0..n)
+                    .map(|j| settings.coefficient_prior.prior(j))
+                    .collect(),
             });
             next += n;
         }
@@ -254,12 +289,20 @@ impl CalibrationPosterior {
 
     /// Range of a record's channel's discrepancy coefficients in x.
     pub fn coefficient_range(&self, record: usize, channel: usize) -> Option<Range<usize>> {
-        let d = self.records[record].channels[channel].discrepancy.as_ref()?;
+        let d = self.records[record].channels[channel]
+            .discrepancy
+            .as_ref()?;
         Some(d.offset..d.offset + d.priors.len())
     }
 
     pub fn discrepancy_description(&self) -> Option<String> {
-        self.records.first()?.channels.first()?.discrepancy.as_ref().map(|d| d.description.clone())
+        self.records
+            .first()?
+            .channels
+            .first()?
+            .discrepancy
+            .as_ref()
+            .map(|d| d.description.clone())
     }
 
     /// δ of a record's channel at the sample times for the coefficients in x (zeros in BM1).
@@ -268,7 +311,8 @@ impl CalibrationPosterior {
         match &ch.discrepancy {
             None => vec![0.0; ch.observed.len()],
             Some(d) => {
-                let a = nalgebra::DVector::from_column_slice(&x[d.offset..d.offset + d.priors.len()]);
+                let a =
+                    nalgebra::DVector::from_column_slice(&x[d.offset..d.offset + d.priors.len()]);
                 (&d.basis * a).as_slice().to_vec()
             }
         }
@@ -293,8 +337,13 @@ impl CalibrationPosterior {
             for c in 0..term.channels.len() {
                 term.residual(c, &x);
                 if let Some(d) = &term.channels[c].discrepancy {
-                    let rhs = d.basis.transpose() * nalgebra::DVector::from_column_slice(&term.residual);
-                    let ridge = DMatrix::from_diagonal_element(d.gram.nrows(), d.gram.nrows(), 1e-9 * d.gram.trace());
+                    let rhs =
+                        d.basis.transpose() * nalgebra::DVector::from_column_slice(&term.residual);
+                    let ridge = DMatrix::from_diagonal_element(
+                        d.gram.nrows(),
+                        d.gram.nrows(),
+                        1e-9 * d.gram.trace(),
+                    );
                     if let Some(chol) = (&d.gram + ridge).cholesky() {
                         let a = chol.solve(&rhs);
                         x[d.offset..d.offset + a.len()].copy_from_slice(a.as_slice());
@@ -303,7 +352,11 @@ impl CalibrationPosterior {
                 }
                 let m = term.residual.len() as f64;
                 let rms = (term.residual.iter().map(|r| r * r).sum::<f64>() / m).sqrt();
-                let scale = term.channels[c].observed.iter().map(|v| v.abs()).fold(0.0, f64::max);
+                let scale = term.channels[c]
+                    .observed
+                    .iter()
+                    .map(|v| v.abs())
+                    .fold(0.0, f64::max);
                 x[term.channels[c].log_sigma_index] = rms.max(1e-6 * scale.max(1e-300)).ln();
             }
         }
@@ -312,7 +365,11 @@ impl CalibrationPosterior {
 
     fn evaluate(&mut self, x: &[f64], mut grad: Option<&mut [f64]>) -> Result<f64, DensityError> {
         if x.len() != self.dim {
-            return Err(DensityError::fatal(format!("point of dimension {} for a density of dimension {}", x.len(), self.dim)));
+            return Err(DensityError::fatal(format!(
+                "point of dimension {} for a density of dimension {}",
+                x.len(),
+                self.dim
+            )));
         }
         if let Some(g) = grad.as_deref_mut() {
             g.fill(0.0);
@@ -349,7 +406,8 @@ impl CalibrationPosterior {
                 lp += -(m as f64) * (s + 0.5 * LN_2PI) - 0.5 * ss * inv_var;
                 lp += self.noise_prior.log_density(sigma) + s;
                 if let Some(g) = grad.as_deref_mut() {
-                    g[ch.log_sigma_index] += -(m as f64) + ss * inv_var + self.noise_prior.gradient(sigma) * sigma + 1.0;
+                    g[ch.log_sigma_index] +=
+                        -(m as f64) + ss * inv_var + self.noise_prior.gradient(sigma) * sigma + 1.0;
                     for k in 0..p {
                         let sens = column_rows(&term.jacobian, k, c * m..(c + 1) * m);
                         g[k] += inv_var * dot(sens, &term.residual);
@@ -360,7 +418,9 @@ impl CalibrationPosterior {
                         let a = x[d.offset + j];
                         lp += prior.log_density(a);
                         if let Some(g) = grad.as_deref_mut() {
-                            g[d.offset + j] += inv_var * dot(d.basis.column(j).as_slice(), &term.residual) + prior.gradient(a);
+                            g[d.offset + j] += inv_var
+                                * dot(d.basis.column(j).as_slice(), &term.residual)
+                                + prior.gradient(a);
                         }
                     }
                 }
@@ -397,7 +457,11 @@ impl LogDensity for CalibrationPosterior {
         self.evaluate(x, None)
     }
 
-    fn log_density_and_gradient(&mut self, x: &[f64], grad: &mut [f64]) -> Result<f64, DensityError> {
+    fn log_density_and_gradient(
+        &mut self,
+        x: &[f64],
+        grad: &mut [f64],
+    ) -> Result<f64, DensityError> {
         self.evaluate(x, Some(grad))
     }
 
@@ -469,7 +533,8 @@ impl FisherMetric for CalibrationPosterior {
                         for i in 0..n {
                             metric[(d.offset + i, d.offset + j)] += inv_var * d.gram[(i, j)];
                         }
-                        metric[(d.offset + j, d.offset + j)] += d.priors[j].curvature(x[d.offset + j]);
+                        metric[(d.offset + j, d.offset + j)] +=
+                            d.priors[j].curvature(x[d.offset + j]);
                     }
                 }
             }
@@ -481,7 +546,11 @@ impl FisherMetric for CalibrationPosterior {
     /// expectation 2M) and the couplings 2Jᵀr/σ², 2Bᵀr/σ² of log σ with θ and a. At the mode
     /// Bᵀr/σ² equals the Laplace prior's pull ±1/b, which the weakly identified R–δ direction
     /// feels; the residual curvature of G in θ is still left out.
-    fn observed_information(&mut self, x: &[f64], out: &mut DMatrix<f64>) -> Result<(), DensityError> {
+    fn observed_information(
+        &mut self,
+        x: &[f64],
+        out: &mut DMatrix<f64>,
+    ) -> Result<(), DensityError> {
         self.fisher_metric(x, out)?;
         let p = self.n_theta();
         for term in &mut self.records {
@@ -494,7 +563,12 @@ impl FisherMetric for CalibrationPosterior {
                 let ss: f64 = term.residual.iter().map(|r| r * r).sum();
                 out[(si, si)] += 2.0 * ss * inv_var - 2.0 * m as f64;
                 for k in 0..p {
-                    let v = 2.0 * inv_var * dot(column_rows(&term.jacobian, k, c * m..(c + 1) * m), &term.residual);
+                    let v = 2.0
+                        * inv_var
+                        * dot(
+                            column_rows(&term.jacobian, k, c * m..(c + 1) * m),
+                            &term.residual,
+                        );
                     out[(si, k)] += v;
                     out[(k, si)] += v;
                 }

@@ -8,10 +8,19 @@ const LN_2PI: f64 = 1.837_877_066_409_345_5;
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "family", rename_all = "snake_case", deny_unknown_fields)]
 pub enum Prior {
-    Normal { mean: f64, sd: f64 },
-    Laplace { location: f64, scale: f64 },
+    Normal {
+        mean: f64,
+        sd: f64,
+    },
+    Laplace {
+        location: f64,
+        scale: f64,
+    },
     /// On a positive quantity x: density ∝ x^{−shape−1} exp(−scale/x).
-    InverseGamma { shape: f64, scale: f64 },
+    InverseGamma {
+        shape: f64,
+        scale: f64,
+    },
 }
 
 impl Prior {
@@ -21,7 +30,9 @@ impl Prior {
                 let z = (x - mean) / sd;
                 -0.5 * z * z - sd.ln() - 0.5 * LN_2PI
             }
-            Prior::Laplace { location, scale } => -(x - location).abs() / scale - (2.0 * scale).ln(),
+            Prior::Laplace { location, scale } => {
+                -(x - location).abs() / scale - (2.0 * scale).ln()
+            }
             Prior::InverseGamma { shape, scale } => {
                 if x <= 0.0 {
                     return f64::NEG_INFINITY;
@@ -55,7 +66,9 @@ impl Prior {
         match *self {
             Prior::Normal { sd, .. } => 1.0 / (sd * sd),
             Prior::Laplace { .. } => 0.0,
-            Prior::InverseGamma { shape, scale } => -(shape + 1.0) / (x * x) + 2.0 * scale / (x * x * x),
+            Prior::InverseGamma { shape, scale } => {
+                -(shape + 1.0) / (x * x) + 2.0 * scale / (x * x * x)
+            }
         }
     }
 
@@ -107,29 +120,88 @@ mod tests {
     fn integrate(prior: Prior, lo: f64, hi: f64) -> f64 {
         let n = 200_000;
         let h = (hi - lo) / n as f64;
-        (0..n).map(|i| prior.log_density(lo + (i as f64 + 0.5) * h).exp() * h).sum()
+        (0..n)
+            .map(|i| prior.log_density(lo + (i as f64 + 0.5) * h).exp() * h)
+            .sum()
     }
 
     #[test]
     fn priors_are_normalised() {
-        assert!((integrate(Prior::Normal { mean: 0.1, sd: 0.02 }, -0.1, 0.3) - 1.0).abs() < 1e-6);
-        assert!((integrate(Prior::Laplace { location: 0.0, scale: 10.0 }, -400.0, 400.0) - 1.0).abs() < 1e-6);
+        assert!(
+            (integrate(
+                Prior::Normal {
+                    mean: 0.1,
+                    sd: 0.02
+                },
+                -0.1,
+                0.3
+            ) - 1.0)
+                .abs()
+                < 1e-6
+        );
+        assert!(
+            (integrate(
+                Prior::Laplace {
+                    location: 0.0,
+                    scale: 10.0
+                },
+                -400.0,
+                400.0
+            ) - 1.0)
+                .abs()
+                < 1e-6
+        );
         // InvGamma(3, 2) has light enough tails to integrate on a finite grid.
-        assert!((integrate(Prior::InverseGamma { shape: 3.0, scale: 2.0 }, 1e-9, 400.0) - 1.0).abs() < 1e-4);
+        assert!(
+            (integrate(
+                Prior::InverseGamma {
+                    shape: 3.0,
+                    scale: 2.0
+                },
+                1e-9,
+                400.0
+            ) - 1.0)
+                .abs()
+                < 1e-4
+        );
     }
 
     #[test]
     fn gradients_and_curvatures_match_finite_differences() {
         let h = 1e-5;
         for (prior, x) in [
-            (Prior::Normal { mean: 0.1, sd: 0.02 }, 0.13),
-            (Prior::Laplace { location: 0.0, scale: 10.0 }, -3.0),
-            (Prior::InverseGamma { shape: 1.0, scale: 1.0 }, 1.7),
+            (
+                Prior::Normal {
+                    mean: 0.1,
+                    sd: 0.02,
+                },
+                0.13,
+            ),
+            (
+                Prior::Laplace {
+                    location: 0.0,
+                    scale: 10.0,
+                },
+                -3.0,
+            ),
+            (
+                Prior::InverseGamma {
+                    shape: 1.0,
+                    scale: 1.0,
+                },
+                1.7,
+            ),
         ] {
             let fd = (prior.log_density(x + h) - prior.log_density(x - h)) / (2.0 * h);
-            assert!((fd - prior.gradient(x)).abs() < 1e-6 * (1.0 + fd.abs()), "{prior:?}");
+            assert!(
+                (fd - prior.gradient(x)).abs() < 1e-6 * (1.0 + fd.abs()),
+                "{prior:?}"
+            );
             let fd2 = -(prior.gradient(x + h) - prior.gradient(x - h)) / (2.0 * h);
-            assert!((fd2 - prior.curvature(x)).abs() < 1e-5 * (1.0 + fd2.abs()), "{prior:?}");
+            assert!(
+                (fd2 - prior.curvature(x)).abs() < 1e-5 * (1.0 + fd2.abs()),
+                "{prior:?}"
+            );
         }
     }
 

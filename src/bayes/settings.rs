@@ -36,7 +36,11 @@ pub struct CoefficientPrior {
 
 impl Default for CoefficientPrior {
     fn default() -> Self {
-        Self { family: CoefficientFamily::Laplace, scale: 10.0, decay_power: 0.0 }
+        Self {
+            family: CoefficientFamily::Laplace,
+            scale: 10.0,
+            decay_power: 0.0,
+        }
     }
 }
 
@@ -45,8 +49,14 @@ impl CoefficientPrior {
     pub fn prior(&self, j: usize) -> super::Prior {
         let variance = 2.0 * self.scale * self.scale / ((j + 1) as f64).powf(self.decay_power);
         match self.family {
-            CoefficientFamily::Laplace => super::Prior::Laplace { location: 0.0, scale: (variance / 2.0).sqrt() },
-            CoefficientFamily::Gaussian => super::Prior::Normal { mean: 0.0, sd: variance.sqrt() },
+            CoefficientFamily::Laplace => super::Prior::Laplace {
+                location: 0.0,
+                scale: (variance / 2.0).sqrt(),
+            },
+            CoefficientFamily::Gaussian => super::Prior::Normal {
+                mean: 0.0,
+                sd: variance.sqrt(),
+            },
         }
     }
 }
@@ -80,11 +90,17 @@ impl Default for ModelSettings {
 
 impl ModelSettings {
     pub fn bm1() -> Self {
-        Self { discrepancy_degree: None, ..Self::default() }
+        Self {
+            discrepancy_degree: None,
+            ..Self::default()
+        }
     }
 
     pub fn bm2(k: usize) -> Self {
-        Self { discrepancy_degree: Some(k), ..Self::default() }
+        Self {
+            discrepancy_degree: Some(k),
+            ..Self::default()
+        }
     }
 
     pub fn label(&self) -> String {
@@ -95,13 +111,13 @@ impl ModelSettings {
     }
 
     pub fn validate(&self) -> Result<(), String> {
-        if let Some(k) = self.discrepancy_degree {
-            if k > super::basis::MAX_LEGENDRE_DEGREE {
-                return Err(format!(
-                    "discrepancy degree K = {k} is larger than the maximum {}",
-                    super::basis::MAX_LEGENDRE_DEGREE
-                ));
-            }
+        if let Some(k) = self.discrepancy_degree
+            && k > super::basis::MAX_LEGENDRE_DEGREE
+        {
+            return Err(format!(
+                "discrepancy degree K = {k} is larger than the maximum {}",
+                super::basis::MAX_LEGENDRE_DEGREE
+            ));
         }
         let positive = [
             ("resistance_prior_spread", self.resistance_prior_spread),
@@ -114,8 +130,13 @@ impl ModelSettings {
                 return Err(format!("{name} = {v} must be a positive number"));
             }
         }
-        if !(self.coefficient_prior.decay_power >= 0.0 && self.coefficient_prior.decay_power.is_finite()) {
-            return Err(format!("coefficient_prior.decay_power = {} must be ≥ 0", self.coefficient_prior.decay_power));
+        if !(self.coefficient_prior.decay_power >= 0.0
+            && self.coefficient_prior.decay_power.is_finite())
+        {
+            return Err(format!(
+                "coefficient_prior.decay_power = {} must be ≥ 0",
+                self.coefficient_prior.decay_power
+            ));
         }
         Ok(())
     }

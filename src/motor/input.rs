@@ -44,7 +44,10 @@ mod tests {
 
     #[test]
     fn held_voltage_changes_only_at_its_breakpoints() {
-        let input = VoltageInput::Held { times: vec![0.1, 0.2, 0.3, 0.4], values: vec![24.0, 24.0, 8.0, -24.0] };
+        let input = VoltageInput::Held {
+            times: vec![0.1, 0.2, 0.3, 0.4],
+            values: vec![24.0, 24.0, 8.0, -24.0],
+        };
         assert_eq!(input.breakpoints(), vec![0.3, 0.4]);
         assert_eq!(input.value_at(0.0), Some(24.0));
         assert_eq!(input.value_at(0.3), Some(8.0));

@@ -39,7 +39,10 @@ impl MotorModel {
 
     /// The nominal values of the full parameter vector.
     pub fn parameter_values(&self) -> Vec<f64> {
-        MotorParam::ALL.iter().map(|&p| self.nominal.get(p)).collect()
+        MotorParam::ALL
+            .iter()
+            .map(|&p| self.nominal.get(p))
+            .collect()
     }
 
     pub fn parameter_index(&self, name: &str) -> Option<usize> {
@@ -66,10 +69,17 @@ impl MotorModel {
 
     /// Equations (3)–(4): L dI/dt = −R I − c_m ω + U and J dω/dt = c_g I − d ω − T_L, with the load
     /// torque opposing motion (the paper writes +T_L but only ever uses T_L = 0).
-    pub fn rhs<D: DualNum<Primitive = f64> + Copy>(&self, voltage: D, y: &[D], p: &[D], dy: &mut [D]) {
+    pub fn rhs<D: DualNum<Primitive = f64> + Copy>(
+        &self,
+        voltage: D,
+        y: &[D],
+        p: &[D],
+        dy: &mut [D],
+    ) {
         use MotorParam::*;
         let (current, speed) = (y[0], y[1]);
-        let electrical = voltage - p[Resistance as usize] * current - p[BackEmfConstant as usize] * speed;
+        let electrical =
+            voltage - p[Resistance as usize] * current - p[BackEmfConstant as usize] * speed;
         let mechanical = p[TorqueConstant as usize] * current
             - p[ViscousFriction as usize] * speed
             - p[LoadTorque as usize];
@@ -90,7 +100,11 @@ impl MotorModel {
         p: &'a [D],
         segments: &'a Segments,
     ) -> MotorSystem<'a, D> {
-        MotorSystem { model: self, p, segments }
+        MotorSystem {
+            model: self,
+            p,
+            segments,
+        }
     }
 
     /// The breakpoints and the input held on each interval between them.
@@ -103,7 +117,10 @@ impl MotorModel {
                 .map(|start| held.value_at(start).unwrap_or(self.nominal.voltage))
                 .collect(),
         };
-        Segments { breakpoints, voltage }
+        Segments {
+            breakpoints,
+            voltage,
+        }
     }
 }
 

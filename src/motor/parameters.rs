@@ -53,7 +53,10 @@ impl MotorParam {
 
     /// Parameters that divide the right-hand side or are physically positive.
     pub fn must_be_positive(self) -> bool {
-        matches!(self, MotorParam::Resistance | MotorParam::Inductance | MotorParam::Inertia)
+        matches!(
+            self,
+            MotorParam::Resistance | MotorParam::Inductance | MotorParam::Inertia
+        )
     }
 }
 
@@ -115,7 +118,10 @@ impl Default for MotorParameters {
 impl MotorParameters {
     /// The paper's simulation model G_φ with φ = 0.9 (§2.4): the torque constant is 10% low.
     pub fn paper_simulation_model() -> Self {
-        Self { torque_constant: 0.009, ..Self::default() }
+        Self {
+            torque_constant: 0.009,
+            ..Self::default()
+        }
     }
 
     pub fn get(&self, p: MotorParam) -> f64 {

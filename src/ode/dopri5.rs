@@ -58,7 +58,12 @@ struct Stages<D> {
 impl<D: DualNum<Primitive = f64> + Copy> Stages<D> {
     fn new(n: usize) -> Self {
         let z = || vec![D::from(0.0); n];
-        Self { k: std::array::from_fn(|_| z()), y_stage: z(), y_new: z(), cont: std::array::from_fn(|_| z()) }
+        Self {
+            k: std::array::from_fn(|_| z()),
+            y_stage: z(),
+            y_new: z(),
+            cont: std::array::from_fn(|_| z()),
+        }
     }
 }
 
@@ -88,15 +93,21 @@ where
             n * t_out.len()
         )));
     }
-    if let Some(&first) = t_out.first() {
-        if !(first >= t0) {
-            return Err(OdeError::BadOutputTimes(format!("first output time {first} before start {t0}")));
-        }
+    if let Some(&first) = t_out.first()
+        && !(first >= t0)
+    {
+        return Err(OdeError::BadOutputTimes(format!(
+            "first output time {first} before start {t0}"
+        )));
     }
     if t_out.windows(2).any(|w| !(w[1] >= w[0])) {
-        return Err(OdeError::BadOutputTimes("output times are not sorted".into()));
+        return Err(OdeError::BadOutputTimes(
+            "output times are not sorted".into(),
+        ));
     }
-    let Some(&t_end) = t_out.last() else { return Ok(stats) };
+    let Some(&t_end) = t_out.last() else {
+        return Ok(stats);
+    };
 
     let breakpoints = system.breakpoints();
     let mut y: Vec<D> = y0.to_vec();
@@ -115,18 +126,34 @@ where
     let mut steps = 0usize;
 
     while next_out < t_out.len() {
-        let seg_end = breakpoints.get(segment).copied().unwrap_or(f64::INFINITY).min(t_end);
+        let seg_end = breakpoints
+            .get(segment)
+            .copied()
+            .unwrap_or(f64::INFINITY)
+            .min(t_end);
         // FSAL is broken at a segment start: the right-hand side has jumped.
         system.rhs(t, segment, &y, &mut s.k[0]);
         stats.rhs_evaluations += 1;
         let mut step = match h {
             Some(h) => h,
-            None => initial_step(system, t, segment, &y, &s.k[0], settings, seg_end - t, &mut stats),
+            None => initial_step(
+                system,
+                t,
+                segment,
+                &y,
+                &s.k[0],
+                settings,
+                seg_end - t,
+                &mut stats,
+            ),
         };
         let mut last_rejected = false;
         while t < seg_end {
             if steps >= settings.max_steps {
-                return Err(OdeError::TooManySteps { t, max_steps: settings.max_steps });
+                return Err(OdeError::TooManySteps {
+                    t,
+                    max_steps: settings.max_steps,
+                });
             }
             steps += 1;
             let remaining = seg_end - t;
@@ -161,14 +188,19 @@ where
                 std::mem::swap(&mut y, &mut s.y_new);
                 s.k.swap(0, 6); // first same as last
                 t = t_new;
-                let mut fac = (fac11 / fac_old.powf(BETA) / SAFETY).clamp(1.0 / MAX_GROWTH, MAX_SHRINK);
+                let mut fac =
+                    (fac11 / fac_old.powf(BETA) / SAFETY).clamp(1.0 / MAX_GROWTH, MAX_SHRINK);
                 if last_rejected {
                     fac = fac.max(1.0);
                 }
                 fac_old = err.max(1e-4);
                 // A step clipped to land on a breakpoint says little about the next segment's
                 // scale: keep the larger of the planned and the proposed size.
-                step = if lands { step.max(h_step / fac) } else { h_step / fac };
+                step = if lands {
+                    step.max(h_step / fac)
+                } else {
+                    h_step / fac
+                };
                 last_rejected = false;
             } else {
                 stats.rejected_steps += 1;
@@ -231,8 +263,13 @@ where
     system.rhs(t + h, segment, yn, k7);
     let mut sum = 0.0;
     for i in 0..n {
-        let e = h * (E1 * k1[i].re() + E3 * k3[i].re() + E4 * k4[i].re() + E5 * k5[i].re() + E6 * k6[i].re()
-            + E7 * k7[i].re());
+        let e = h
+            * (E1 * k1[i].re()
+                + E3 * k3[i].re()
+                + E4 * k4[i].re()
+                + E5 * k5[i].re()
+                + E6 * k6[i].re()
+                + E7 * k7[i].re());
         let scale = settings.atol + settings.rtol * y[i].re().abs().max(yn[i].re().abs());
         sum += (e / scale).powi(2);
     }
@@ -256,7 +293,8 @@ fn dense_coefficients<D: DualNum<Primitive = f64> + Copy>(h: f64, y: &[D], s: &m
 fn interpolate<D: DualNum<Primitive = f64> + Copy>(theta: f64, c: &[Vec<D>; 5], out: &mut [D]) {
     let theta1 = 1.0 - theta;
     for i in 0..out.len() {
-        out[i] = c[0][i] + (c[1][i] + (c[2][i] + (c[3][i] + c[4][i] * theta1) * theta) * theta1) * theta;
+        out[i] =
+            c[0][i] + (c[1][i] + (c[2][i] + (c[3][i] + c[4][i] * theta1) * theta) * theta1) * theta;
     }
 }
 
@@ -278,16 +316,25 @@ where
 {
     let n = y.len();
     let scale = |v: f64| settings.atol + settings.rtol * v.abs();
-    let rms = |f: &dyn Fn(usize) -> f64| ((0..n).map(|i| f(i).powi(2)).sum::<f64>() / n as f64).sqrt();
+    let rms =
+        |f: &dyn Fn(usize) -> f64| ((0..n).map(|i| f(i).powi(2)).sum::<f64>() / n as f64).sqrt();
     let d0 = rms(&|i| y[i].re() / scale(y[i].re()));
     let d1 = rms(&|i| f0[i].re() / scale(y[i].re()));
-    let h0 = if d0 < 1e-5 || d1 < 1e-5 { 1e-6 } else { 0.01 * d0 / d1 };
+    let h0 = if d0 < 1e-5 || d1 < 1e-5 {
+        1e-6
+    } else {
+        0.01 * d0 / d1
+    };
     let h0 = h0.min(max_h);
     let y1: Vec<D> = (0..n).map(|i| y[i] + f0[i] * h0).collect();
     let mut f1 = vec![D::from(0.0); n];
     system.rhs(t + h0, segment, &y1, &mut f1);
     stats.rhs_evaluations += 1;
     let d2 = rms(&|i| (f1[i].re() - f0[i].re()) / scale(y[i].re())) / h0;
-    let h1 = if d1.max(d2) <= 1e-15 { (h0 * 1e-3).max(1e-6) } else { (0.01 / d1.max(d2)).powf(0.2) };
+    let h1 = if d1.max(d2) <= 1e-15 {
+        (h0 * 1e-3).max(1e-6)
+    } else {
+        (0.01 / d1.max(d2)).powf(0.2)
+    };
     (100.0 * h0).min(h1).min(max_h)
 }

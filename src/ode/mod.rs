@@ -35,14 +35,22 @@ pub struct SolverSettings {
 
 impl Default for SolverSettings {
     fn default() -> Self {
-        Self { rtol: 1e-8, atol: 1e-8, max_steps: 50_000 }
+        Self {
+            rtol: 1e-8,
+            atol: 1e-8,
+            max_steps: 50_000,
+        }
     }
 }
 
 impl SolverSettings {
     /// The tighter tolerance used to generate synthetic data.
     pub fn for_data_generation() -> Self {
-        Self { rtol: 1e-10, atol: 1e-10, ..Self::default() }
+        Self {
+            rtol: 1e-10,
+            atol: 1e-10,
+            ..Self::default()
+        }
     }
 }
 
@@ -70,7 +78,9 @@ impl std::fmt::Display for OdeError {
             OdeError::TooManySteps { t, max_steps } => {
                 write!(f, "integrator gave up after {max_steps} steps at t = {t}")
             }
-            OdeError::StepSizeUnderflow { t, h } => write!(f, "step size underflow (h = {h:e}) at t = {t}"),
+            OdeError::StepSizeUnderflow { t, h } => {
+                write!(f, "step size underflow (h = {h:e}) at t = {t}")
+            }
             OdeError::NonFinite { t } => write!(f, "solution became non-finite at t = {t}"),
             OdeError::BadOutputTimes(msg) => write!(f, "bad output times: {msg}"),
         }

@@ -27,7 +27,11 @@ pub struct ChainSettings {
 
 impl Default for ChainSettings {
     fn default() -> Self {
-        Self { warmup: 1000, draws: 1000, keep: None }
+        Self {
+            warmup: 1000,
+            draws: 1000,
+            keep: None,
+        }
     }
 }
 
@@ -36,10 +40,10 @@ impl ChainSettings {
         if self.draws == 0 {
             return Err("the number of draws must be at least 1".into());
         }
-        if let Some(keep) = self.keep {
-            if keep == 0 || keep > self.draws {
-                return Err(format!("cannot keep {keep} draws of {} drawn", self.draws));
-            }
+        if let Some(keep) = self.keep
+            && (keep == 0 || keep > self.draws)
+        {
+            return Err(format!("cannot keep {keep} draws of {} drawn", self.draws));
         }
         Ok(())
     }
@@ -97,6 +101,7 @@ impl ChainOutput {
 
 /// Runs one chain: `settings.warmup` transitions with adaptation, then `settings.draws`
 /// with the kernel frozen.
+#[allow(clippy::too_many_arguments)]
 pub fn run_chain<P, K, A>(
     density: P,
     mut kernel: K,
@@ -117,7 +122,9 @@ where
     let names = density.output_names();
     let mut state: State = kernel.init_state(&mut density, init)?;
     if !state.log_density.is_finite() {
-        return Err(DensityError::fatal(format!("chain {chain}: the initial point has zero density")));
+        return Err(DensityError::fatal(format!(
+            "chain {chain}: the initial point has zero density"
+        )));
     }
     let total = settings.warmup + settings.draws;
     let reporter = Reporter::new(progress, total);
@@ -219,7 +226,9 @@ where
             let (density, kernel, adaptation) = make(chain)?;
             let mut rng = chain_rng(seed, chain);
             let bar = progress.and_then(|bars| bars.get(chain));
-            run_chain(density, kernel, adaptation, init, settings, &mut rng, chain, bar)
+            run_chain(
+                density, kernel, adaptation, init, settings, &mut rng, chain, bar,
+            )
         })
         .collect()
 }
@@ -237,13 +246,18 @@ impl<'a> Reporter<'a> {
             b.set_length(total as u64);
             b.set_position(0);
         }
-        Self { bar, last: std::cell::Cell::new(Instant::now()), accepted: std::cell::Cell::new((0, 0)) }
+        Self {
+            bar,
+            last: std::cell::Cell::new(Instant::now()),
+            accepted: std::cell::Cell::new((0, 0)),
+        }
     }
 
     fn tick(&self, iteration: usize, info: &Info, divergences: usize, phase: &str) {
         let Some(bar) = self.bar else { return };
         let (acc, n) = self.accepted.get();
-        self.accepted.set((acc + (info.accept_stat * 1000.0) as u64, n + 1));
+        self.accepted
+            .set((acc + (info.accept_stat * 1000.0) as u64, n + 1));
         if self.last.get().elapsed() < Duration::from_millis(100) {
             return;
         }

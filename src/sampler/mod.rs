@@ -54,19 +54,39 @@ pub trait Kernel<P: LogDensity> {
         if self.uses_gradient() {
             let mut gradient = vec![0.0; x.len()];
             let log_density = density.log_density_and_gradient(x, &mut gradient)?;
-            Ok(State { x: x.to_vec(), log_density, gradient })
+            Ok(State {
+                x: x.to_vec(),
+                log_density,
+                gradient,
+            })
         } else {
-            Ok(State { x: x.to_vec(), log_density: density.log_density(x)?, gradient: Vec::new() })
+            Ok(State {
+                x: x.to_vec(),
+                log_density: density.log_density(x)?,
+                gradient: Vec::new(),
+            })
         }
     }
     /// One transition. A fatal density error aborts the chain.
-    fn step(&mut self, density: &mut P, state: &mut State, rng: &mut ChaCha8Rng) -> Result<Info, DensityError>;
+    fn step(
+        &mut self,
+        density: &mut P,
+        state: &mut State,
+        rng: &mut ChaCha8Rng,
+    ) -> Result<Info, DensityError>;
 }
 
 /// Tunes a kernel during warm-up from the transitions it observes; frozen afterwards.
 pub trait Adaptation<K> {
     /// Called after every warm-up transition `iteration` (0-based) of `n_warmup`.
-    fn observe(&mut self, kernel: &mut K, state: &State, info: &Info, iteration: usize, n_warmup: usize);
+    fn observe(
+        &mut self,
+        kernel: &mut K,
+        state: &State,
+        info: &Info,
+        iteration: usize,
+        n_warmup: usize,
+    );
     /// Called once when warm-up ends: set the final tuned values.
     fn finish(&mut self, kernel: &mut K);
 }

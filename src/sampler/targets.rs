@@ -16,7 +16,10 @@ pub struct Gaussian {
 impl Gaussian {
     pub fn new(mean: Vec<f64>, covariance: DMatrix<f64>) -> Self {
         let d = mean.len();
-        let chol = covariance.clone().cholesky().expect("covariance must be positive definite");
+        let chol = covariance
+            .clone()
+            .cholesky()
+            .expect("covariance must be positive definite");
         let log_det: f64 = 2.0 * chol.l().diagonal().iter().map(|v| v.ln()).sum::<f64>();
         let precision = chol.inverse();
         Self {
@@ -32,9 +35,17 @@ impl Gaussian {
     /// posterior's bad conditioning.
     pub fn correlated(d: usize, rho: f64, scale_ratio: f64) -> Self {
         let sd: Vec<f64> = (0..d)
-            .map(|i| if d == 1 { 1.0 } else { scale_ratio.powf(i as f64 / (d - 1) as f64) })
+            .map(|i| {
+                if d == 1 {
+                    1.0
+                } else {
+                    scale_ratio.powf(i as f64 / (d - 1) as f64)
+                }
+            })
             .collect();
-        let cov = DMatrix::from_fn(d, d, |i, j| sd[i] * sd[j] * rho.powi((i as i32 - j as i32).abs()));
+        let cov = DMatrix::from_fn(d, d, |i, j| {
+            sd[i] * sd[j] * rho.powi((i as i32 - j as i32).abs())
+        });
         let mean = (0..d).map(|i| i as f64 - 0.5 * d as f64).collect();
         Self::new(mean, cov)
     }
@@ -58,7 +69,11 @@ impl LogDensity for Gaussian {
         Ok(self.log_normaliser - 0.5 * r.dot(&(&self.precision * &r)))
     }
 
-    fn log_density_and_gradient(&mut self, x: &[f64], grad: &mut [f64]) -> Result<f64, DensityError> {
+    fn log_density_and_gradient(
+        &mut self,
+        x: &[f64],
+        grad: &mut [f64],
+    ) -> Result<f64, DensityError> {
         let r = DVector::from_column_slice(x) - &self.mean;
         let pr = &self.precision * &r;
         for (g, v) in grad.iter_mut().zip(pr.iter()) {
@@ -93,17 +108,27 @@ pub fn check_gaussian_moments(
         let n: usize = columns.iter().map(|c| c.len()).sum();
         let mean = columns.iter().flatten().sum::<f64>() / n as f64;
         let z_mean = (mean - target.mean[j]) / mcse_mean(&columns);
-        let squares: Vec<Vec<f64>> =
-            columns.iter().map(|c| c.iter().map(|v| (v - target.mean[j]).powi(2)).collect()).collect();
+        let squares: Vec<Vec<f64>> = columns
+            .iter()
+            .map(|c| c.iter().map(|v| (v - target.mean[j]).powi(2)).collect())
+            .collect();
         let var = squares.iter().flatten().sum::<f64>() / n as f64;
         let z_var = (var - variances[j]) / mcse_mean(&squares);
         worst_mean = worst_mean.max(z_mean.abs());
         worst_var = worst_var.max(z_var.abs());
         if !(z_mean.abs() <= k) {
-            return Err(format!("mean of x.{} = {mean} vs {} ({z_mean:.2} MCSE)", j + 1, target.mean[j]));
+            return Err(format!(
+                "mean of x.{} = {mean} vs {} ({z_mean:.2} MCSE)",
+                j + 1,
+                target.mean[j]
+            ));
         }
         if !(z_var.abs() <= k) {
-            return Err(format!("variance of x.{} = {var} vs {} ({z_var:.2} MCSE)", j + 1, variances[j]));
+            return Err(format!(
+                "variance of x.{} = {var} vs {} ({z_var:.2} MCSE)",
+                j + 1,
+                variances[j]
+            ));
         }
     }
     Ok((worst_mean, worst_var))

@@ -1,0 +1,60 @@
+//! The commands behind the binary: each turns options into library calls and reports. Kept in
+//! the library so that tests drive them exactly as a user does.
+
+pub mod problem;
+pub mod run;
+pub mod simulate;
+pub mod summarize;
+
+use std::fmt;
+
+use crate::density::DensityError;
+use crate::io::InputError;
+
+/// Everything a command can fail with, printed as one line by the binary.
+#[derive(Debug)]
+pub enum AppError {
+    Input(InputError),
+    Usage(String),
+    Numerical(String),
+    Output(String),
+}
+
+impl fmt::Display for AppError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            AppError::Input(e) => write!(f, "{e}"),
+            AppError::Usage(m) => write!(f, "{m}"),
+            AppError::Numerical(m) => write!(f, "numerical failure: {m}"),
+            AppError::Output(m) => write!(f, "could not write output: {m}"),
+        }
+    }
+}
+
+impl std::error::Error for AppError {}
+
+impl From<InputError> for AppError {
+    fn from(e: InputError) -> Self {
+        AppError::Input(e)
+    }
+}
+
+impl From<DensityError> for AppError {
+    fn from(e: DensityError) -> Self {
+        AppError::Numerical(e.message)
+    }
+}
+
+impl From<std::io::Error> for AppError {
+    fn from(e: std::io::Error) -> Self {
+        AppError::Output(e.to_string())
+    }
+}
+
+/// Provenance written into every output: crate version and the commit it was built from.
+pub fn provenance() -> Vec<(String, String)> {
+    vec![
+        ("motorcal_version".into(), env!("CARGO_PKG_VERSION").into()),
+        ("git_commit".into(), env!("MOTORCAL_GIT_COMMIT").into()),
+    ]
+}

@@ -1,0 +1,337 @@
+//! Running a sampler on a posterior: MAP start, overdispersed initial points, chains in
+//! parallel, draws to disk, diagnostics. Shared by `fit`, `reproduce` and `bench`.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
+use nalgebra::DVector;
+use rand_distr::{Distribution, StandardNormal};
+use serde::Serialize;
+
+use crate::bayes::CalibrationPosterior;
+use crate::density::Counted;
+use crate::density::{DensityError, LogDensity};
+use crate::diagnostics::{ParameterSummary, summarize};
+use crate::io::{CmdStanWriter, SamplerColumns};
+use crate::optimize::{MapEstimate, MapSettings, find_map};
+use crate::sampler::driver::chain_rng;
+use crate::sampler::{Adaptation, ChainOutput, ChainSettings, Kernel, run_chains};
+
+use super::AppError;
+
+/// The samplers a user can pick.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum SamplerKind {
+    /// The paper's Metropolis: one random-walk step per variable in turn, tuned as PyMC3 did.
+    Metropolis,
+    /// Adaptive Metropolis (Haario et al. 2001): joint proposal from the warm-up covariance.
+    AdaptiveMetropolis,
+}
+
+impl SamplerKind {
+    pub fn name(&self) -> &'static str {
+        match self {
+            SamplerKind::Metropolis => "metropolis",
+            SamplerKind::AdaptiveMetropolis => "adaptive-metropolis",
+        }
+    }
+}
+
+/// How to run a sampler.
+#[derive(Clone, Debug, Serialize)]
+pub struct RunSettings {
+    pub sampler: SamplerKind,
+    pub chains: usize,
+    pub chain: ChainSettings,
+    pub seed: u64,
+    /// Worker threads (all cores when `None`); the draws do not depend on it.
+    pub threads: Option<usize>,
+    /// Initial points are the MAP plus draws from the Laplace approximation with its standard
+    /// deviations inflated by this factor, so that R-hat can detect chains that do not mix.
+    pub init_dispersion: f64,
+    pub quiet: bool,
+}
+
+impl Default for RunSettings {
+    fn default() -> Self {
+        Self {
+            sampler: SamplerKind::AdaptiveMetropolis,
+            chains: 4,
+            chain: ChainSettings::default(),
+            seed: crate::synthetic::DEFAULT_SEED,
+            threads: None,
+            init_dispersion: 3.0,
+            quiet: false,
+        }
+    }
+}
+
+impl RunSettings {
+    pub fn validate(&self) -> Result<(), AppError> {
+        if self.chains == 0 {
+            return Err(AppError::Usage(
+                "--chains 0: need at least one chain".into(),
+            ));
+        }
+        if self.threads == Some(0) {
+            return Err(AppError::Usage(
+                "--threads 0: need at least one thread".into(),
+            ));
+        }
+        self.chain
+            .validate()
+            .map_err(|e| AppError::Usage(format!("--keep/--draws: {e}")))?;
+        Ok(())
+    }
+}
+
+/// The result of a run.
+#[derive(Clone, Debug, Serialize)]
+pub struct RunOutput {
+    pub sampler: String,
+    #[serde(skip)]
+    pub chains: Vec<ChainOutput>,
+    pub summaries: Vec<ParameterSummary>,
+    pub max_rhat: f64,
+    pub min_ess_bulk: f64,
+    pub wall_seconds: f64,
+    pub warmup_seconds: f64,
+    pub sampling_seconds: f64,
+    pub sampling_density_evaluations: u64,
+    pub sampling_gradient_evaluations: u64,
+    pub divergences: usize,
+    pub map_log_density: f64,
+    pub log_evidence_laplace: f64,
+}
+
+impl RunOutput {
+    pub fn summary(&self, name: &str) -> Option<&ParameterSummary> {
+        self.summaries.iter().find(|s| s.name == name)
+    }
+}
+
+/// The MAP from the posterior's own starting point.
+pub fn map_estimate(posterior: &mut CalibrationPosterior) -> Result<MapEstimate, AppError> {
+    let start = posterior.initial_point()?;
+    Ok(find_map(posterior, &start, &MapSettings::default())?)
+}
+
+/// Initial points: the MAP plus N(0, (c²) H⁻¹) jitter, on a random stream of its own so the
+/// samplers' streams are untouched. A jittered point with zero density is redrawn closer.
+pub fn initial_points(
+    posterior: &mut CalibrationPosterior,
+    map: &MapEstimate,
+    chains: usize,
+    dispersion: f64,
+    seed: u64,
+) -> Result<Vec<Vec<f64>>, AppError> {
+    let d = map.x.len();
+    let chol = map.hessian.clone().cholesky().ok_or_else(|| {
+        AppError::Numerical("the Hessian at the MAP is not positive definite".into())
+    })?;
+    let l_inv_t = chol
+        .l()
+        .transpose()
+        .try_inverse()
+        .ok_or_else(|| AppError::Numerical("singular Hessian".into()))?;
+    let mut inits = Vec::with_capacity(chains);
+    for chain in 0..chains {
+        let mut rng = chain_rng(seed ^ 0x1a17_0000, chain);
+        let mut scale = dispersion;
+        let point = loop {
+            let z = DVector::from_iterator(d, (0..d).map(|_| StandardNormal.sample(&mut rng)));
+            let dx = &l_inv_t * z * scale;
+            let x: Vec<f64> = map.x.iter().zip(dx.iter()).map(|(a, b)| a + b).collect();
+            match posterior.log_density(&x) {
+                Ok(lp) if lp.is_finite() => break x,
+                _ if scale > 1e-3 => scale *= 0.5,
+                _ => break map.x.clone(),
+            }
+        };
+        inits.push(point);
+    }
+    Ok(inits)
+}
+
+/// One progress bar per chain, or none when quiet.
+pub fn progress_bars(
+    chains: usize,
+    label: &str,
+    quiet: bool,
+) -> Option<(MultiProgress, Vec<ProgressBar>)> {
+    if quiet {
+        return None;
+    }
+    let multi = MultiProgress::with_draw_target(ProgressDrawTarget::stderr_with_hz(5));
+    let style = ProgressStyle::with_template("{prefix:>24} [{bar:30}] {pos:>7}/{len:7} {msg}")
+        .expect("valid template")
+        .progress_chars("=> ");
+    let bars = (0..chains)
+        .map(|c| {
+            let bar = multi.add(ProgressBar::new(1));
+            bar.set_style(style.clone());
+            bar.set_prefix(format!("{label} chain {}", c + 1));
+            bar
+        })
+        .collect();
+    Some((multi, bars))
+}
+
+/// Runs any kernel/adaptation pair on clones of the posterior from the given initial points.
+pub fn execute<K, A, F>(
+    posterior: &CalibrationPosterior,
+    inits: &[Vec<f64>],
+    settings: &RunSettings,
+    label: &str,
+    make: F,
+) -> Result<Vec<ChainOutput>, AppError>
+where
+    K: Kernel<Counted<CalibrationPosterior>> + Send,
+    A: Adaptation<K>,
+    F: Fn(usize) -> Result<(K, A), DensityError> + Sync,
+{
+    let bars = progress_bars(inits.len(), label, settings.quiet);
+    let work = || {
+        run_chains(
+            inits,
+            &settings.chain,
+            settings.seed,
+            |c| {
+                let (k, a) = make(c)?;
+                Ok((posterior.clone(), k, a))
+            },
+            bars.as_ref().map(|(_, b)| b.as_slice()),
+        )
+    };
+    let result = match settings.threads {
+        Some(n) => rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .map_err(|e| AppError::Usage(format!("--threads {n}: {e}")))?
+            .install(work),
+        None => work(),
+    };
+    Ok(result?.into_iter().map(|(output, _)| output).collect())
+}
+
+/// Diagnostics of every reported quantity over all chains.
+pub fn summarize_chains(chains: &[ChainOutput]) -> Vec<ParameterSummary> {
+    let Some(first) = chains.first() else {
+        return Vec::new();
+    };
+    first
+        .names
+        .iter()
+        .enumerate()
+        .map(|(j, name)| {
+            let columns: Vec<Vec<f64>> = chains.iter().map(|c| c.column(j)).collect();
+            summarize(name.clone(), &columns)
+        })
+        .collect()
+}
+
+/// Collects chain outputs into a run summary.
+pub fn finish_run(
+    sampler: &str,
+    chains: Vec<ChainOutput>,
+    map: &MapEstimate,
+    started: Instant,
+) -> RunOutput {
+    let summaries = summarize_chains(&chains);
+    let max_rhat = summaries
+        .iter()
+        .map(|s| s.rhat)
+        .fold(f64::NEG_INFINITY, f64::max);
+    let min_ess_bulk = summaries
+        .iter()
+        .map(|s| s.ess_bulk)
+        .fold(f64::INFINITY, f64::min);
+    RunOutput {
+        sampler: sampler.to_string(),
+        max_rhat,
+        min_ess_bulk,
+        wall_seconds: started.elapsed().as_secs_f64(),
+        warmup_seconds: chains.iter().map(|c| c.warmup_seconds).fold(0.0, f64::max),
+        sampling_seconds: chains
+            .iter()
+            .map(|c| c.sampling_seconds)
+            .fold(0.0, f64::max),
+        sampling_density_evaluations: chains.iter().map(|c| c.sampling_density_evaluations).sum(),
+        sampling_gradient_evaluations: chains.iter().map(|c| c.sampling_gradient_evaluations).sum(),
+        divergences: chains.iter().map(|c| c.divergences).sum(),
+        map_log_density: map.log_density,
+        log_evidence_laplace: map.log_evidence_laplace,
+        summaries,
+        chains,
+    }
+}
+
+/// Runs `settings.sampler` on the posterior from overdispersed starts around the MAP.
+pub fn run_sampler(
+    posterior: &mut CalibrationPosterior,
+    settings: &RunSettings,
+    label: &str,
+) -> Result<RunOutput, AppError> {
+    settings.validate()?;
+    let started = Instant::now();
+    let map = map_estimate(posterior)?;
+    let inits = initial_points(
+        posterior,
+        &map,
+        settings.chains,
+        settings.init_dispersion,
+        settings.seed,
+    )?;
+    let label = format!("{label} {}", settings.sampler.name());
+    let chains = dispatch(posterior, &map, &inits, settings, &label)?;
+    Ok(finish_run(settings.sampler.name(), chains, &map, started))
+}
+
+fn dispatch(
+    posterior: &CalibrationPosterior,
+    map: &MapEstimate,
+    inits: &[Vec<f64>],
+    settings: &RunSettings,
+    label: &str,
+) -> Result<Vec<ChainOutput>, AppError> {
+    let _ = (posterior, map, inits, settings, label);
+    Err(AppError::Usage("samplers are not wired yet".into()))
+}
+
+/// Writes each chain's draws in CmdStan's CSV layout with the run's provenance.
+pub fn write_draws(
+    dir: &Path,
+    prefix: &str,
+    run: &RunOutput,
+    metadata: &[(String, String)],
+) -> Result<Vec<PathBuf>, AppError> {
+    let mut paths = Vec::new();
+    for chain in &run.chains {
+        let path = dir.join(format!(
+            "{prefix}-{}-chain{}.csv",
+            run.sampler,
+            chain.chain + 1
+        ));
+        let mut meta = metadata.to_vec();
+        meta.push(("sampler".into(), run.sampler.clone()));
+        meta.push(("chain".into(), (chain.chain + 1).to_string()));
+        let mut writer = CmdStanWriter::create(&path, &meta, &chain.names)?;
+        for (draw, record) in chain.draws.iter().zip(&chain.records) {
+            let columns = SamplerColumns {
+                lp: record.lp,
+                accept_stat: record.accept_stat,
+                stepsize: record.step_size,
+                treedepth: record.tree_depth,
+                n_leapfrog: record.n_steps as u64,
+                divergent: record.divergent,
+                energy: record.energy,
+            };
+            writer.write_draw(&columns, draw)?;
+        }
+        writer.finish()?;
+        paths.push(path);
+    }
+    Ok(paths)
+}

@@ -1,0 +1,256 @@
+//! Model files: the nominal motor the user believes and how their recording's columns are named,
+//! as TOML.
+
+use std::io;
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use super::atomic::write_atomically;
+use super::error::{InputError, line_and_column, read_text};
+use super::recording::ChannelMap;
+use crate::motor::{MotorParam, MotorParameters};
+
+/// The model-file format version this build reads and writes.
+pub const MODEL_FILE_SCHEMA: u32 = 1;
+
+/// A model file. Every table refuses unknown keys, so a misspelt key is an error instead of a
+/// silently ignored setting; missing keys take their defaults.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModelFile {
+    /// Format version; files from a newer version are refused rather than misread.
+    #[serde(default = "default_schema")]
+    pub schema: u32,
+    #[serde(default)]
+    pub motor: MotorParameters,
+    #[serde(default)]
+    pub channels: ChannelMap,
+}
+
+fn default_schema() -> u32 {
+    MODEL_FILE_SCHEMA
+}
+
+impl Default for ModelFile {
+    fn default() -> Self {
+        Self {
+            schema: MODEL_FILE_SCHEMA,
+            motor: MotorParameters::default(),
+            channels: ChannelMap::default(),
+        }
+    }
+}
+
+/// Reads and checks a model file: TOML syntax, known keys, value types, the schema version and
+/// the motor's physical plausibility ([`MotorParameters::validate`]).
+pub fn read_model_file(path: &Path) -> Result<ModelFile, InputError> {
+    let text = read_text(path, |text, line, _| {
+        key_paths(text).get(line - 1).cloned().flatten()
+    })?;
+    parse_model_file(&text, path)
+}
+
+/// Parses model-file text; `path` only names the file in errors.
+pub fn parse_model_file(text: &str, path: &Path) -> Result<ModelFile, InputError> {
+    let model: ModelFile = toml::from_str(text).map_err(|e| toml_error(text, path, &e))?;
+    let paths = key_paths(text);
+    let line_of = |key: &str| {
+        paths
+            .iter()
+            .position(|p| p.as_deref() == Some(key))
+            .map(|i| i + 1)
+    };
+
+    if model.schema != MODEL_FILE_SCHEMA {
+        return Err(InputError::new(
+            path,
+            format!(
+                "schema {} is not supported; this version of motorcal reads schema {MODEL_FILE_SCHEMA}",
+                model.schema
+            ),
+        )
+        .at_line_opt(line_of("schema"))
+        .for_field("schema"));
+    }
+    if let Err(message) = model.motor.validate() {
+        // validate() reports "KEY = value ..."; the key tells which line to point at.
+        let key = message
+            .split(" = ")
+            .next()
+            .and_then(MotorParam::from_key)
+            .map(|p| p.key());
+        let field = key.map(|k| format!("motor.{k}"));
+        let line = field.as_deref().and_then(line_of);
+        return Err(InputError::new(path, message)
+            .at_line_opt(line)
+            .for_field_opt(field));
+    }
+    Ok(model)
+}
+
+/// The TOML text of a model file, which [`read_model_file`] reads back to the same values.
+pub fn to_toml_string(model: &ModelFile) -> String {
+    // Plain tables of numbers and strings always serialize; this can only fail if ModelFile grows
+    // a type TOML cannot express, which the round-trip test catches.
+    toml::to_string(model).expect("a ModelFile always serializes to TOML")
+}
+
+/// Writes a model file atomically.
+pub fn write_model_file(path: &Path, model: &ModelFile) -> io::Result<()> {
+    write_atomically(path, to_toml_string(model).as_bytes())
+}
+
+/// One line for a TOML error: the line from the error's byte span, the key from the text there
+/// (qualified by its table, since `U` is both a motor parameter and a channel) or, for a key in a
+/// table header or a multi-line value, from the message.
+fn toml_error(text: &str, path: &Path, e: &toml::de::Error) -> InputError {
+    let line = e
+        .span()
+        .map(|span| line_and_column(text.as_bytes(), span.start).0);
+    let field = line
+        .and_then(|l| key_paths(text).get(l - 1).cloned().flatten())
+        .or_else(|| backticked(e.message()));
+    let mut message = e.message().replace('\n', "; ");
+    if message.starts_with("unknown field") {
+        message.push_str(" (keys are case-sensitive)");
+    }
+    InputError::new(path, message)
+        .at_line_opt(line)
+        .for_field_opt(field)
+}
+
+/// The first `name` in a message like "unknown field `name`, expected ...".
+fn backticked(message: &str) -> Option<String> {
+    let rest = &message[message.find('`')? + 1..];
+    Some(rest[..rest.find('`')?].to_owned())
+}
+
+/// For every line of `text`, the dotted path of the key assigned there (`motor.R`), if any.
+///
+/// A small line scanner, not a TOML parser: it only has to find where keys are written in files
+/// that `toml` already accepted (or where it stopped), so that errors found after parsing point at
+/// a line too.
+fn key_paths(text: &str) -> Vec<Option<String>> {
+    let mut table: Vec<String> = Vec::new();
+    text.lines()
+        .map(|raw| {
+            let line = raw.trim();
+            if line.starts_with('[') {
+                let inner = line.trim_start_matches('[');
+                let inner = inner.split(']').next().unwrap_or("");
+                table = key_segments(inner);
+                None
+            } else if line.starts_with('#') {
+                None
+            } else {
+                let (key, _) = line.split_once('=')?;
+                let segments = key_segments(key);
+                if segments.is_empty() {
+                    return None;
+                }
+                Some(
+                    table
+                        .iter()
+                        .chain(&segments)
+                        .cloned()
+                        .collect::<Vec<_>>()
+                        .join("."),
+                )
+            }
+        })
+        .collect()
+}
+
+fn key_segments(key: &str) -> Vec<String> {
+    key.split('.')
+        .map(|s| s.trim().trim_matches(|c| c == '"' || c == '\'').to_owned())
+        .filter(|s| !s.is_empty())
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<ModelFile, InputError> {
+        parse_model_file(text, Path::new("m.toml"))
+    }
+
+    #[test]
+    fn missing_keys_and_tables_take_defaults() {
+        assert_eq!(parse("").unwrap(), ModelFile::default());
+        let m = parse("[motor]\nR = 0.2\n[channels]\nt = \"time\"\n").unwrap();
+        assert_eq!(
+            m.motor,
+            MotorParameters {
+                resistance: 0.2,
+                ..MotorParameters::default()
+            }
+        );
+        assert_eq!(m.channels.t, "time");
+        assert_eq!(m.channels.current, "I");
+        // An integer where a float is expected is what people write.
+        assert_eq!(parse("[motor]\nU = 12\n").unwrap().motor.voltage, 12.0);
+    }
+
+    #[test]
+    fn keys_are_found_with_their_table() {
+        let paths =
+            key_paths("schema = 1\n[motor]\n  \"R\" = 2 # x\n# c = 1\n[channels]\nU = \"V\"\n");
+        assert_eq!(
+            paths,
+            [
+                Some("schema".into()),
+                None,
+                Some("motor.R".into()),
+                None,
+                None,
+                Some("channels.U".into())
+            ]
+        );
+        assert_eq!(key_paths("motor.J = 1\n"), [Some("motor.J".to_owned())]);
+    }
+
+    #[test]
+    fn errors_point_at_line_and_key() {
+        let cases = [
+            ("[motor]\nR = 0.1\nRr = 2\n", 3, "motor.Rr", "unknown field"),
+            ("[motor]\nR = \"a\"\n", 2, "motor.R", "invalid type"),
+            ("[motor]\nR = 1e400\n", 2, "motor.R", "overflow"),
+            ("[motorr]\nR = 1\n", 1, "motorr", "unknown field"),
+            ("schema = 2\n", 1, "schema", "not supported"),
+            ("schema = -1\n", 1, "schema", "u32"),
+            ("\n[motor]\nL = 0.0\n", 3, "motor.L", "positive"),
+            ("[motor]\nJ = -1e-5\n", 2, "motor.J", "positive"),
+            ("[motor]\nc_m = nan\n", 2, "motor.c_m", "finite"),
+            ("[motor]\nd = inf\n", 2, "motor.d", "finite"),
+            (
+                "[channels]\nspeed = \"w\"\n",
+                2,
+                "channels.speed",
+                "unknown field",
+            ),
+        ];
+        for (text, line, field, message) in cases {
+            let e = parse(text).unwrap_err();
+            assert_eq!(e.line, Some(line), "{text:?}: {e}");
+            assert_eq!(e.field.as_deref(), Some(field), "{text:?}: {e}");
+            assert!(e.message.contains(message), "{text:?}: {e}");
+            assert!(!e.to_string().contains('\n'));
+        }
+        let e = parse("[motor\nR = 1\n").unwrap_err();
+        assert_eq!(e.line, Some(1), "{e}");
+    }
+
+    #[test]
+    fn the_toml_text_reads_back_to_the_same_values() {
+        let mut model = ModelFile::default();
+        model.motor.resistance = 1.0 / 3.0;
+        model.motor.inertia = 1.234_567_890_123e-7;
+        model.motor.voltage = 1e300;
+        model.channels.speed = "w rad/s".into();
+        let back = parse(&to_toml_string(&model)).unwrap();
+        assert_eq!(back, model);
+    }
+}
