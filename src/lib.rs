@@ -19,5 +19,6 @@ pub mod io;
 pub mod motor;
 pub mod ode;
 pub mod optimize;
+pub mod plot;
 pub mod sampler;
 pub mod synthetic;

@@ -43,6 +43,11 @@ enum Command {
         #[arg(long, default_value_t = 0.5)]
         t_end: f64,
     },
+    /// Reproduce a result of the paper.
+    Reproduce {
+        #[command(subcommand)]
+        what: Reproduce,
+    },
     /// Print ESS, R-hat and MCSE for draws files (CmdStan CSV, or a long chain,draw,… table).
     Summarize {
         #[arg(required = true)]
@@ -53,9 +58,61 @@ enum Command {
     },
 }
 
+#[derive(Subcommand)]
+enum Reproduce {
+    /// Table 1: BM1 and BM2(K = 9) on the paper's synthetic data, with the paper's protocol.
+    Table1(Table1Args),
+}
+
+#[derive(clap::Args, Default)]
+struct Table1Args {
+    /// Seed of the synthetic noise and of the chains.
+    #[arg(long, default_value_t = motorcal::synthetic::DEFAULT_SEED)]
+    seed: u64,
+    /// BM2 runs of 10000 instead of 100000 draws.
+    #[arg(long)]
+    quick: bool,
+    /// Samplers to run, comma separated.
+    #[arg(long, value_enum, value_delimiter = ',', default_values_t = [app::run::SamplerKind::Metropolis, app::run::SamplerKind::AdaptiveMetropolis])]
+    samplers: Vec<app::run::SamplerKind>,
+    /// Chains per run.
+    #[arg(long, default_value_t = 3)]
+    chains: usize,
+    /// Worker threads (default: all cores); draws do not depend on it.
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Output folder for draws, table1.json and table1.csv.
+    #[arg(long, default_value = "out/table1")]
+    out: PathBuf,
+    /// No progress bars.
+    #[arg(long)]
+    quiet: bool,
+}
+
+fn table1(args: Table1Args) -> Result<(), AppError> {
+    let options = app::table1::Table1Options {
+        seed: args.seed,
+        quick: args.quick,
+        samplers: args.samplers,
+        chains: args.chains,
+        threads: args.threads,
+        out: args.out,
+        quiet: args.quiet,
+    };
+    let report = app::table1::reproduce_table1(&options)?;
+    print!("{}", app::table1::format_report(&report));
+    println!("
+wrote {}/table1.json, table1.csv and the draws (CmdStan CSV)", options.out.display());
+    Ok(())
+}
+
 fn run(cli: Cli) -> Result<(), AppError> {
     match cli.command {
-        None => Err(AppError::Usage("no command yet".into())),
+        None => {
+            println!("motorcal: reproducing the paper's Table 1 (see `motorcal --help` for the other commands)\n");
+            table1(Table1Args { samplers: vec![app::run::SamplerKind::Metropolis, app::run::SamplerKind::AdaptiveMetropolis], chains: 3, seed: motorcal::synthetic::DEFAULT_SEED, out: PathBuf::from("out/table1"), ..Default::default() })
+        }
+        Some(Command::Reproduce { what: Reproduce::Table1(args) }) => table1(args),
         Some(Command::Simulate {
             truth,
             nominal,

@@ -5,6 +5,7 @@ pub mod problem;
 pub mod run;
 pub mod simulate;
 pub mod summarize;
+pub mod table1;
 
 use std::fmt;
 

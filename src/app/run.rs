@@ -16,6 +16,8 @@ use crate::diagnostics::{ParameterSummary, summarize};
 use crate::io::{CmdStanWriter, SamplerColumns};
 use crate::optimize::{MapEstimate, MapSettings, find_map};
 use crate::sampler::driver::chain_rng;
+use crate::sampler::adaptive_metropolis::{AdaptiveMetropolis, HaarioAdaptation};
+use crate::sampler::metropolis::{Metropolis, PyMc3Tuning};
 use crate::sampler::{Adaptation, ChainOutput, ChainSettings, Kernel, run_chains};
 
 use super::AppError;
@@ -296,8 +298,17 @@ fn dispatch(
     settings: &RunSettings,
     label: &str,
 ) -> Result<Vec<ChainOutput>, AppError> {
-    let _ = (posterior, map, inits, settings, label);
-    Err(AppError::Usage("samplers are not wired yet".into()))
+    match settings.sampler {
+        SamplerKind::Metropolis => execute(posterior, inits, settings, label, |_| {
+            Ok((Metropolis::for_density(posterior), PyMc3Tuning::new()))
+        }),
+        SamplerKind::AdaptiveMetropolis => execute(posterior, inits, settings, label, |_| {
+            // Started from the Laplace covariance: the posterior's scales span ten orders of
+            // magnitude, which an isotropic start would spend the warm-up discovering.
+            let kernel = AdaptiveMetropolis::from_precision(&map.hessian).map_err(DensityError::fatal)?;
+            Ok((kernel, HaarioAdaptation::default()))
+        }),
+    }
 }
 
 /// Writes each chain's draws in CmdStan's CSV layout with the run's provenance.

@@ -97,8 +97,10 @@ impl RecordTerm {
             *r = y - gi;
         }
         if let Some(d) = &ch.discrepancy {
-            for (j, &a) in x[d.offset..d.offset + d.priors.len()].iter().enumerate() {
-                for (r, &b) in self.residual.iter_mut().zip(d.basis.column(j).iter()) {
+            let coefficients = &x[d.offset..d.offset + d.priors.len()];
+            for (j, &a) in coefficients.iter().enumerate() {
+                let column = column_rows(&d.basis, j, 0..m);
+                for (r, &b) in self.residual.iter_mut().zip(column) {
                     *r -= a * b;
                 }
             }
@@ -268,6 +270,11 @@ impl CalibrationPosterior {
 
     pub fn theta_names(&self) -> &[String] {
         &self.theta_names
+    }
+
+    /// Number of reported quantities (equal to the dimension: one per coordinate).
+    pub fn dim_of_outputs(&self) -> usize {
+        self.output_names.len()
     }
 
     pub fn n_records(&self) -> usize {
@@ -574,7 +581,7 @@ impl FisherMetric for CalibrationPosterior {
                 }
                 if let Some(d) = &ch.discrepancy {
                     for j in 0..d.priors.len() {
-                        let v = 2.0 * inv_var * dot(d.basis.column(j).as_slice(), &term.residual);
+                        let v = 2.0 * inv_var * dot(column_rows(&d.basis, j, 0..m), &term.residual);
                         out[(si, d.offset + j)] += v;
                         out[(d.offset + j, si)] += v;
                     }

@@ -5,7 +5,11 @@
 //! adaptation watches the `Info`s during warm-up and retunes the kernel's parameters, then
 //! freezes them. The driver knows neither's internals.
 
+pub mod adaptive_metropolis;
 pub mod driver;
+pub mod metropolis;
+pub mod fisher_mala;
+pub mod mala;
 pub mod targets;
 
 pub use driver::{ChainOutput, ChainSettings, DrawRecord, run_chain, run_chains};

@@ -1,0 +1,780 @@
+//! Preconditioned MALA: one Langevin step with a fixed preconditioner M⁻¹, corrected by
+//! Metropolis–Hastings with the asymmetric proposal densities,
+//!
+//!   x' = x + (ε²/2) M⁻¹ ∇log π(x) + ε L ξ,   M⁻¹ = L Lᵀ,   ξ ~ N(0, I).
+//!
+//! The adaptation tunes ε by dual averaging toward the acceptance rate that is optimal for
+//! MALA (0.574, Roberts & Rosenthal 1998) and, optionally, re-estimates M⁻¹ from warm-up
+//! draws in Stan's doubling windows. The dual-averaging controller is shared with the
+//! Fisher-metric kernel.
+
+use nalgebra::DMatrix;
+use rand::RngExt;
+use rand_chacha::ChaCha8Rng;
+use rand_distr::StandardNormal;
+use serde::{Deserialize, Serialize};
+
+use super::{Adaptation, Info, Kernel, State};
+use crate::density::{DensityError, LogDensity};
+
+/// The inverse mass matrix M⁻¹ of a preconditioned kernel: the proposal covariance up to ε².
+/// A good choice is the posterior covariance, or the inverse of the Hessian at the mode.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Preconditioner {
+    /// Diagonal of M⁻¹ (the marginal variances).
+    Diagonal(Vec<f64>),
+    /// Dense, symmetric positive-definite M⁻¹.
+    Dense(DMatrix<f64>),
+}
+
+impl Preconditioner {
+    pub fn identity(dim: usize) -> Self {
+        Self::Diagonal(vec![1.0; dim])
+    }
+
+    /// M⁻¹ = H⁻¹ for a positive-definite Hessian of −log π (e.g. `MapEstimate::hessian`).
+    pub fn from_hessian(hessian: &DMatrix<f64>) -> Result<Self, String> {
+        let chol = hessian
+            .clone()
+            .cholesky()
+            .ok_or("the Hessian is not positive definite")?;
+        Ok(Self::Dense(chol.inverse()))
+    }
+
+    pub fn dim(&self) -> usize {
+        match self {
+            Self::Diagonal(v) => v.len(),
+            Self::Dense(m) => m.nrows(),
+        }
+    }
+
+    /// The same preconditioner with its off-diagonal part dropped.
+    pub fn diagonal(&self) -> Vec<f64> {
+        match self {
+            Self::Diagonal(v) => v.clone(),
+            Self::Dense(m) => m.diagonal().iter().copied().collect(),
+        }
+    }
+}
+
+/// A square root L of M⁻¹ (L Lᵀ = M⁻¹), lower triangular when dense.
+#[derive(Clone, Debug)]
+enum Factor {
+    Diagonal(Vec<f64>),
+    Dense(DMatrix<f64>),
+}
+
+impl Factor {
+    fn new(preconditioner: &Preconditioner) -> Result<Self, String> {
+        match preconditioner {
+            Preconditioner::Diagonal(v) => {
+                if let Some((i, bad)) = v
+                    .iter()
+                    .enumerate()
+                    .find(|(_, v)| !(v.is_finite() && **v > 0.0))
+                {
+                    return Err(format!(
+                        "inverse mass {bad} at coordinate {i} is not positive and finite"
+                    ));
+                }
+                Ok(Self::Diagonal(v.iter().map(|v| v.sqrt()).collect()))
+            }
+            Preconditioner::Dense(m) => {
+                if !m.is_square() {
+                    return Err(format!(
+                        "the inverse mass matrix is {}×{}",
+                        m.nrows(),
+                        m.ncols()
+                    ));
+                }
+                let mut l = m.clone();
+                if !cholesky_in_place(&mut l) {
+                    return Err("the inverse mass matrix is not positive definite".into());
+                }
+                Ok(Self::Dense(l))
+            }
+        }
+    }
+
+    /// out = L v
+    fn mul(&self, v: &[f64], out: &mut [f64]) {
+        match self {
+            Self::Diagonal(s) => {
+                for ((o, s), v) in out.iter_mut().zip(s).zip(v) {
+                    *o = s * v;
+                }
+            }
+            Self::Dense(l) => lower_mul(l, v, out),
+        }
+    }
+
+    /// out = Lᵀ v
+    fn tr_mul(&self, v: &[f64], out: &mut [f64]) {
+        match self {
+            Self::Diagonal(s) => {
+                for ((o, s), v) in out.iter_mut().zip(s).zip(v) {
+                    *o = s * v;
+                }
+            }
+            Self::Dense(l) => lower_tr_mul(l, v, out),
+        }
+    }
+}
+
+/// Overwrites the lower triangle of a symmetric matrix with its Cholesky factor and zeroes the
+/// upper one, without allocating. False when the matrix is not (numerically) positive
+/// definite or not finite; the matrix is then garbage.
+pub(crate) fn cholesky_in_place(a: &mut DMatrix<f64>) -> bool {
+    let n = a.nrows();
+    if a.ncols() != n {
+        return false;
+    }
+    for j in 0..n {
+        let mut diag = a[(j, j)];
+        for k in 0..j {
+            diag -= a[(j, k)] * a[(j, k)];
+        }
+        // `!(diag > 0)` also catches NaN.
+        if !(diag > 0.0 && diag.is_finite()) {
+            return false;
+        }
+        let ljj = diag.sqrt();
+        a[(j, j)] = ljj;
+        for i in j + 1..n {
+            let mut v = a[(i, j)];
+            for k in 0..j {
+                v -= a[(i, k)] * a[(j, k)];
+            }
+            a[(i, j)] = v / ljj;
+        }
+        for i in 0..j {
+            a[(i, j)] = 0.0;
+        }
+    }
+    true
+}
+
+/// out = L v for lower-triangular L (column-major: column j contributes v_j L[j.., j]).
+pub(crate) fn lower_mul(l: &DMatrix<f64>, v: &[f64], out: &mut [f64]) {
+    let n = l.nrows();
+    out.fill(0.0);
+    for (j, &vj) in v.iter().enumerate() {
+        let col = &l.as_slice()[j * n..(j + 1) * n];
+        for i in j..n {
+            out[i] += col[i] * vj;
+        }
+    }
+}
+
+/// out = Lᵀ v for lower-triangular L (each entry a dot product with a contiguous column).
+pub(crate) fn lower_tr_mul(l: &DMatrix<f64>, v: &[f64], out: &mut [f64]) {
+    let n = l.nrows();
+    for (j, o) in out.iter_mut().enumerate() {
+        let col = &l.as_slice()[j * n..(j + 1) * n];
+        *o = col[j..].iter().zip(&v[j..]).map(|(a, b)| a * b).sum();
+    }
+}
+
+/// What a proposal's density evaluation said: whether it can be weighed at all.
+pub(crate) enum Evaluated {
+    Finite(f64),
+    /// Outside the support (or a non-finite value or gradient): rejected, not a failure.
+    Outside,
+    /// A recoverable failure: rejected and counted like a divergence.
+    Failed,
+}
+
+pub(crate) fn evaluate<P: LogDensity>(
+    density: &mut P,
+    x: &[f64],
+    gradient: &mut [f64],
+) -> Result<Evaluated, DensityError> {
+    match density.log_density_and_gradient(x, gradient) {
+        Ok(lp) if lp.is_finite() && gradient.iter().all(|g| g.is_finite()) => {
+            Ok(Evaluated::Finite(lp))
+        }
+        Ok(lp) if lp == f64::NEG_INFINITY => Ok(Evaluated::Outside),
+        // +∞, NaN or a non-finite gradient inside the support is a numerical failure.
+        Ok(_) => Ok(Evaluated::Failed),
+        Err(e) if e.recoverable => Ok(Evaluated::Failed),
+        Err(e) => Err(e),
+    }
+}
+
+/// The Metropolis–Hastings decision for a log acceptance ratio: (accept_stat, accepted).
+/// The uniform is drawn whatever happens, so that a rejection never shifts the random stream.
+pub(crate) fn metropolis(log_ratio: f64, rng: &mut ChaCha8Rng) -> (f64, bool) {
+    let u: f64 = rng.random();
+    let accept_stat = if log_ratio.is_nan() {
+        0.0
+    } else {
+        log_ratio.min(0.0).exp()
+    };
+    (accept_stat, u.ln() < log_ratio)
+}
+
+pub(crate) fn check_state(state: &State, dim: usize) -> Result<(), DensityError> {
+    if state.x.len() != dim || state.gradient.len() != dim {
+        return Err(DensityError::fatal(format!(
+            "a state with {} coordinates and {} gradient entries for a kernel of dimension {dim}",
+            state.x.len(),
+            state.gradient.len()
+        )));
+    }
+    Ok(())
+}
+
+/// Preconditioned MALA with a fixed M⁻¹ (fixed during sampling; an adaptation may replace it
+/// during warm-up).
+#[derive(Clone, Debug)]
+pub struct Mala {
+    step_size: f64,
+    preconditioner: Preconditioner,
+    factor: Factor,
+    noise: Vec<f64>,
+    /// Lᵀ∇log π at the current state and at the proposal: the drift in whitened coordinates.
+    whitened_gradient: Vec<f64>,
+    whitened_gradient_new: Vec<f64>,
+    scratch: Vec<f64>,
+    proposal: Vec<f64>,
+    proposal_gradient: Vec<f64>,
+    failures: u64,
+}
+
+impl Mala {
+    /// A kernel with inverse mass matrix `preconditioner` and step size `step_size` (in the
+    /// preconditioner's units: about 1 when M⁻¹ is the posterior covariance in a few
+    /// dimensions, shrinking like d^(-1/6)).
+    pub fn new(preconditioner: Preconditioner, step_size: f64) -> Result<Self, String> {
+        if !(step_size > 0.0 && step_size.is_finite()) {
+            return Err(format!(
+                "the step size must be positive and finite, not {step_size}"
+            ));
+        }
+        let factor = Factor::new(&preconditioner)?;
+        let d = preconditioner.dim();
+        Ok(Self {
+            step_size,
+            preconditioner,
+            factor,
+            noise: vec![0.0; d],
+            whitened_gradient: vec![0.0; d],
+            whitened_gradient_new: vec![0.0; d],
+            scratch: vec![0.0; d],
+            proposal: vec![0.0; d],
+            proposal_gradient: vec![0.0; d],
+            failures: 0,
+        })
+    }
+
+    pub fn dim(&self) -> usize {
+        self.preconditioner.dim()
+    }
+
+    pub fn step_size(&self) -> f64 {
+        self.step_size
+    }
+
+    pub fn set_step_size(&mut self, step_size: f64) {
+        self.step_size = step_size;
+    }
+
+    pub fn preconditioner(&self) -> &Preconditioner {
+        &self.preconditioner
+    }
+
+    /// Replaces M⁻¹ (same dimension); the kernel is unchanged on error.
+    pub fn set_preconditioner(&mut self, preconditioner: Preconditioner) -> Result<(), String> {
+        if preconditioner.dim() != self.dim() {
+            return Err(format!(
+                "a preconditioner of dimension {} for a kernel of dimension {}",
+                preconditioner.dim(),
+                self.dim()
+            ));
+        }
+        self.factor = Factor::new(&preconditioner)?;
+        self.preconditioner = preconditioner;
+        Ok(())
+    }
+
+    /// Proposals rejected because the density failed recoverably (or was not finite inside
+    /// its support); each is also reported as divergent.
+    pub fn failures(&self) -> u64 {
+        self.failures
+    }
+}
+
+impl<P: LogDensity> Kernel<P> for Mala {
+    fn name(&self) -> String {
+        "mala".into()
+    }
+
+    fn uses_gradient(&self) -> bool {
+        true
+    }
+
+    fn step(
+        &mut self,
+        density: &mut P,
+        state: &mut State,
+        rng: &mut ChaCha8Rng,
+    ) -> Result<Info, DensityError> {
+        check_state(state, self.dim())?;
+        let eps = self.step_size;
+        self.factor
+            .tr_mul(&state.gradient, &mut self.whitened_gradient);
+        for z in &mut self.noise {
+            *z = rng.sample(StandardNormal);
+        }
+        // In whitened coordinates the move is (ε²/2) Lᵀg + ε ξ; L maps it back.
+        for ((s, u), z) in self
+            .scratch
+            .iter_mut()
+            .zip(&self.whitened_gradient)
+            .zip(&self.noise)
+        {
+            *s = 0.5 * eps * eps * u + eps * z;
+        }
+        self.factor.mul(&self.scratch, &mut self.proposal);
+        for (p, x) in self.proposal.iter_mut().zip(&state.x) {
+            *p += x;
+        }
+
+        let mut lp_new = f64::NEG_INFINITY;
+        let (log_ratio, failed) =
+            match evaluate(density, &self.proposal, &mut self.proposal_gradient)? {
+                Evaluated::Finite(lp) => {
+                    lp_new = lp;
+                    self.factor
+                        .tr_mul(&self.proposal_gradient, &mut self.whitened_gradient_new);
+                    // The reverse move's whitened residual L⁻¹(x − μ(x')) / ε equals
+                    // −ξ − (ε/2) Lᵀ(g + g'), because L⁻¹M⁻¹ = Lᵀ: no triangular solve needed.
+                    let mut forward = 0.0;
+                    let mut reverse = 0.0;
+                    for ((z, u), u_new) in self
+                        .noise
+                        .iter()
+                        .zip(&self.whitened_gradient)
+                        .zip(&self.whitened_gradient_new)
+                    {
+                        let r = z + 0.5 * eps * (u + u_new);
+                        forward += z * z;
+                        reverse += r * r;
+                    }
+                    (
+                        lp_new - state.log_density + 0.5 * (forward - reverse),
+                        false,
+                    )
+                }
+                Evaluated::Outside => (f64::NEG_INFINITY, false),
+                Evaluated::Failed => (f64::NEG_INFINITY, true),
+            };
+        self.failures += failed as u64;
+        let (accept_stat, accepted) = metropolis(log_ratio, rng);
+        if accepted {
+            std::mem::swap(&mut state.x, &mut self.proposal);
+            std::mem::swap(&mut state.gradient, &mut self.proposal_gradient);
+            state.log_density = lp_new;
+        }
+        Ok(Info {
+            accept_stat,
+            accepted,
+            divergent: failed,
+            step_size: eps,
+            tree_depth: 0,
+            n_steps: 1,
+            energy: -state.log_density,
+            block_accepted: Vec::new(),
+        })
+    }
+}
+
+/// Dual averaging of log ε toward a target acceptance (Nesterov 2009; Hoffman & Gelman 2014,
+/// §3.2; Stan's t₀ and κ, a larger γ). Restartable, for when the preconditioner changes.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct DualAveragingSettings {
+    pub target_accept: f64,
+    /// Shrinkage of log ε toward μ = log(10 ε₀): how boldly early iterations move. Stan's
+    /// 0.05 suits NUTS, whose statistic averages a whole trajectory; the single-proposal
+    /// statistic of MALA is noisier, the iterates scatter more in log ε, and because
+    /// acceptance is concave in log ε near the target the frozen average then accepts too
+    /// often (0.61–0.66 for 0.574 after 300–1000 warm-up transitions on an 8-d Gaussian).
+    /// 0.1 halves that bias and is no worse after long warm-ups.
+    pub gamma: f64,
+    /// Damps the first iterations.
+    pub t0: f64,
+    /// Decay of the averaging weights: the averaged ε forgets early iterations like t^-κ.
+    pub kappa: f64,
+}
+
+impl Default for DualAveragingSettings {
+    fn default() -> Self {
+        Self {
+            target_accept: 0.574,
+            gamma: 0.1,
+            t0: 10.0,
+            kappa: 0.75,
+        }
+    }
+}
+
+impl DualAveragingSettings {
+    pub fn with_target(target_accept: f64) -> Self {
+        Self {
+            target_accept,
+            ..Self::default()
+        }
+    }
+
+    pub fn validate(&self) -> Result<(), String> {
+        if !(self.target_accept > 0.0 && self.target_accept < 1.0) {
+            return Err(format!(
+                "the target acceptance must lie in (0, 1), not {}",
+                self.target_accept
+            ));
+        }
+        if !(self.gamma > 0.0 && self.t0 >= 0.0 && self.kappa > 0.5 && self.kappa <= 1.0) {
+            return Err("dual averaging needs γ > 0, t₀ ≥ 0 and κ in (0.5, 1]".into());
+        }
+        Ok(())
+    }
+}
+
+const LOG_STEP_BOUND: f64 = 300.0;
+
+/// The dual-averaging controller's state.
+#[derive(Clone, Debug)]
+pub struct DualAveraging {
+    settings: DualAveragingSettings,
+    mu: f64,
+    h_bar: f64,
+    log_step_bar: f64,
+    t: f64,
+}
+
+impl DualAveraging {
+    pub fn new(settings: DualAveragingSettings, initial_step_size: f64) -> Result<Self, String> {
+        settings.validate()?;
+        if !(initial_step_size > 0.0 && initial_step_size.is_finite()) {
+            return Err(format!(
+                "the initial step size must be positive and finite, not {initial_step_size}"
+            ));
+        }
+        let mut da = Self {
+            settings,
+            mu: 0.0,
+            h_bar: 0.0,
+            log_step_bar: 0.0,
+            t: 0.0,
+        };
+        da.restart(initial_step_size);
+        Ok(da)
+    }
+
+    pub fn settings(&self) -> &DualAveragingSettings {
+        &self.settings
+    }
+
+    /// Starts afresh from `step_size` (forgetting the averages).
+    pub fn restart(&mut self, step_size: f64) {
+        self.mu = (10.0 * step_size).ln();
+        self.h_bar = 0.0;
+        self.log_step_bar = step_size.ln();
+        self.t = 0.0;
+    }
+
+    /// Feeds one transition's acceptance statistic; returns the step size to use next.
+    pub fn update(&mut self, accept_stat: f64) -> f64 {
+        let s = &self.settings;
+        let accept = if accept_stat.is_finite() {
+            accept_stat.clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        self.t += 1.0;
+        let w = 1.0 / (self.t + s.t0);
+        self.h_bar = (1.0 - w) * self.h_bar + w * (s.target_accept - accept);
+        // Bounded so that a long run of rejections cannot drive ε to exactly 0 (or ∞), where
+        // the proposal densities would be 0/0.
+        let log_step =
+            (self.mu - self.t.sqrt() / s.gamma * self.h_bar).clamp(-LOG_STEP_BOUND, LOG_STEP_BOUND);
+        let eta = self.t.powf(-s.kappa);
+        self.log_step_bar = eta * log_step + (1.0 - eta) * self.log_step_bar;
+        log_step.exp()
+    }
+
+    /// The averaged step size: the one to freeze.
+    pub fn final_step_size(&self) -> f64 {
+        self.log_step_bar.exp()
+    }
+}
+
+/// How the warm-up re-estimates M⁻¹.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum PreconditionerAdaptation {
+    /// Keep the constructor's M⁻¹ (e.g. the inverse MAP Hessian).
+    #[default]
+    Fixed,
+    /// Marginal variances of the warm-up draws.
+    Diagonal,
+    /// Full covariance of the warm-up draws, shrunk toward its diagonal.
+    Dense,
+}
+
+/// Settings of [`MalaAdaptation`]. The window fractions are Stan's (75, 50 and 25 of 1000).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct MalaAdaptationSettings {
+    pub step_size: DualAveragingSettings,
+    pub preconditioner: PreconditionerAdaptation,
+    /// Fraction of warm-up spent on the step size alone before the first window, while the
+    /// chain travels from its start into the typical set.
+    pub initial_buffer: f64,
+    /// Fraction of warm-up at the end spent on the step size alone, for the final M⁻¹.
+    pub final_buffer: f64,
+    /// Length of the first estimation window, as a fraction; each next window is twice as long.
+    pub first_window: f64,
+}
+
+impl Default for MalaAdaptationSettings {
+    fn default() -> Self {
+        Self {
+            step_size: DualAveragingSettings::default(),
+            preconditioner: PreconditionerAdaptation::Fixed,
+            initial_buffer: 0.075,
+            final_buffer: 0.05,
+            first_window: 0.025,
+        }
+    }
+}
+
+impl MalaAdaptationSettings {
+    pub fn validate(&self) -> Result<(), String> {
+        self.step_size.validate()?;
+        let ok = |f: f64| (0.0..1.0).contains(&f);
+        if !(ok(self.initial_buffer)
+            && ok(self.final_buffer)
+            && self.first_window > 0.0
+            && self.initial_buffer + self.final_buffer + self.first_window <= 1.0)
+        {
+            return Err(
+                "the warm-up fractions must be in [0, 1) and leave room for a window".into(),
+            );
+        }
+        Ok(())
+    }
+}
+
+/// Tunes a [`Mala`] during warm-up: ε by dual averaging throughout, and M⁻¹ (unless fixed) at
+/// the end of each of Stan's doubling windows, from the draws of that window only. A single
+/// window over the second half of warm-up would learn the scales from draws that the initial
+/// M⁻¹ kept from spreading out (with M⁻¹ = I on scales that span 100×, the widest coordinate
+/// has barely moved); each doubling window starts from a better M⁻¹ and sees more of the
+/// target. After every update ε restarts, since its scale is relative to M⁻¹.
+#[derive(Clone, Debug)]
+pub struct MalaAdaptation {
+    settings: MalaAdaptationSettings,
+    dual: DualAveraging,
+    /// Window ends (exclusive iteration indices), computed on the first observation.
+    windows: Vec<(usize, usize)>,
+    window: usize,
+    estimator: CovarianceEstimator,
+}
+
+impl MalaAdaptation {
+    /// Dual averaging starts from the kernel's step size at the first warm-up transition.
+    pub fn new(settings: MalaAdaptationSettings) -> Result<Self, String> {
+        settings.validate()?;
+        let dual = DualAveraging::new(settings.step_size.clone(), 1.0)?;
+        Ok(Self {
+            settings,
+            dual,
+            windows: Vec::new(),
+            window: 0,
+            estimator: CovarianceEstimator::default(),
+        })
+    }
+
+    /// Step size only, toward 0.574, with the kernel's M⁻¹ kept.
+    pub fn step_size_only() -> Self {
+        Self::new(MalaAdaptationSettings::default()).expect("the default settings are valid")
+    }
+
+    /// Step size and M⁻¹ re-estimated as `preconditioner` says, with the other defaults.
+    pub fn with_preconditioner(preconditioner: PreconditionerAdaptation) -> Self {
+        Self::new(MalaAdaptationSettings {
+            preconditioner,
+            ..MalaAdaptationSettings::default()
+        })
+        .expect("the default settings are valid")
+    }
+
+    /// The estimation windows `[start, end)` for a warm-up of `n_warmup` transitions.
+    pub fn windows_for(&self, n_warmup: usize) -> Vec<(usize, usize)> {
+        if self.settings.preconditioner == PreconditionerAdaptation::Fixed {
+            return Vec::new();
+        }
+        let n = n_warmup as f64;
+        let start = (self.settings.initial_buffer * n).round() as usize;
+        let end = n_warmup - (self.settings.final_buffer * n).round() as usize;
+        let mut size = ((self.settings.first_window * n).round() as usize).max(1);
+        // Fewer than ~10 draws per window estimate nothing useful.
+        if end <= start || end - start < 10 {
+            return Vec::new();
+        }
+        let mut windows = Vec::new();
+        let mut a = start;
+        while a < end {
+            let mut b = (a + size).min(end);
+            // Stretch a window whose successor would not fit (Stan's rule).
+            if b + 2 * size > end {
+                b = end;
+            }
+            windows.push((a, b));
+            a = b;
+            size *= 2;
+        }
+        windows
+    }
+}
+
+impl Adaptation<Mala> for MalaAdaptation {
+    fn observe(
+        &mut self,
+        kernel: &mut Mala,
+        state: &State,
+        info: &Info,
+        iteration: usize,
+        n_warmup: usize,
+    ) {
+        if iteration == 0 {
+            self.dual.restart(kernel.step_size());
+            self.windows = self.windows_for(n_warmup);
+            self.window = 0;
+            self.estimator
+                .reset(kernel.dim(), self.settings.preconditioner);
+        }
+        kernel.set_step_size(self.dual.update(info.accept_stat));
+
+        let Some(&(start, end)) = self.windows.get(self.window) else {
+            return;
+        };
+        if iteration >= start {
+            self.estimator.push(&state.x);
+        }
+        if iteration + 1 == end {
+            if let Some(p) = self.estimator.estimate(kernel.preconditioner()) {
+                // An estimate that fails to factor keeps the old M⁻¹: warm-up goes on.
+                if kernel.set_preconditioner(p).is_ok() {
+                    let step = self.dual.final_step_size();
+                    kernel.set_step_size(step);
+                    self.dual.restart(step);
+                }
+            }
+            self.estimator
+                .reset(kernel.dim(), self.settings.preconditioner);
+            self.window += 1;
+        }
+    }
+
+    fn finish(&mut self, kernel: &mut Mala) {
+        kernel.set_step_size(self.dual.final_step_size());
+    }
+}
+
+/// Welford's running mean and (co)variance, allocation-free after `reset`.
+#[derive(Clone, Debug, Default)]
+struct CovarianceEstimator {
+    kind: PreconditionerAdaptation,
+    n: usize,
+    mean: Vec<f64>,
+    delta: Vec<f64>,
+    /// Sum of squared deviations: d×d (column-major) for dense, d for diagonal.
+    m2: Vec<f64>,
+}
+
+impl CovarianceEstimator {
+    fn reset(&mut self, dim: usize, kind: PreconditionerAdaptation) {
+        self.kind = kind;
+        self.n = 0;
+        self.mean.clear();
+        self.mean.resize(dim, 0.0);
+        self.delta.clear();
+        self.delta.resize(dim, 0.0);
+        let len = match kind {
+            PreconditionerAdaptation::Fixed => 0,
+            PreconditionerAdaptation::Diagonal => dim,
+            PreconditionerAdaptation::Dense => dim * dim,
+        };
+        self.m2.clear();
+        self.m2.resize(len, 0.0);
+    }
+
+    fn push(&mut self, x: &[f64]) {
+        self.n += 1;
+        let n = self.n as f64;
+        for ((m, d), &xi) in self.mean.iter_mut().zip(&mut self.delta).zip(x) {
+            *d = xi - *m;
+            *m += *d / n;
+        }
+        // M2 += δ_before ⊗ (x − mean_after)
+        let dim = x.len();
+        match self.kind {
+            PreconditionerAdaptation::Fixed => {}
+            PreconditionerAdaptation::Diagonal => {
+                for i in 0..dim {
+                    self.m2[i] += self.delta[i] * (x[i] - self.mean[i]);
+                }
+            }
+            PreconditionerAdaptation::Dense => {
+                for j in 0..dim {
+                    let after = x[j] - self.mean[j];
+                    for i in 0..dim {
+                        self.m2[j * dim + i] += self.delta[i] * after;
+                    }
+                }
+            }
+        }
+    }
+
+    /// The window's estimate of M⁻¹, or None when there are too few draws to say anything.
+    /// A coordinate that never moved in the window keeps its previous variance. The dense
+    /// covariance is shrunk toward its own diagonal with weight 5/(n + 5), a scale-free target
+    /// (Stan's shrinkage toward 10⁻³·I would swamp coordinates whose variance is 10⁻⁸), which
+    /// keeps it positive definite even with fewer draws than dimensions.
+    fn estimate(&self, previous: &Preconditioner) -> Option<Preconditioner> {
+        if self.n < 3 {
+            return None;
+        }
+        let dim = self.mean.len();
+        let n = self.n as f64;
+        let old = previous.diagonal();
+        let variance = |i: usize, m2: f64| {
+            let v = m2 / (n - 1.0);
+            if v > 0.0 && v.is_finite() { v } else { old[i] }
+        };
+        match self.kind {
+            PreconditionerAdaptation::Fixed => None,
+            PreconditionerAdaptation::Diagonal => Some(Preconditioner::Diagonal(
+                (0..dim).map(|i| variance(i, self.m2[i])).collect(),
+            )),
+            PreconditionerAdaptation::Dense => {
+                let w = n / (n + 5.0);
+                let diag: Vec<f64> = (0..dim)
+                    .map(|i| variance(i, self.m2[i * dim + i]))
+                    .collect();
+                let cov = DMatrix::from_fn(dim, dim, |i, j| {
+                    if i == j {
+                        diag[i]
+                    } else {
+                        let c = 0.5 * (self.m2[j * dim + i] + self.m2[i * dim + j]) / (n - 1.0);
+                        if c.is_finite() { w * c } else { 0.0 }
+                    }
+                });
+                Some(Preconditioner::Dense(cov))
+            }
+        }
+    }
+}
