@@ -43,6 +43,8 @@ enum Command {
         #[arg(long, default_value_t = 0.5)]
         t_end: f64,
     },
+    /// Calibrate a model file on a recording with BM1 or BM2(K): MAP, then MCMC.
+    Fit(FitArgs),
     /// Reproduce a result of the paper.
     Reproduce {
         #[command(subcommand)]
@@ -89,6 +91,115 @@ struct Table1Args {
     quiet: bool,
 }
 
+#[derive(clap::Args)]
+struct FitArgs {
+    /// The recording (CSV with t, I, omega[, U]).
+    #[arg(long)]
+    data: PathBuf,
+    /// The nominal model (TOML).
+    #[arg(long)]
+    model: PathBuf,
+    /// Bayesian model: 1 (noise only) or 2 (noise + discrepancy).
+    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(1..=2))]
+    bm: u8,
+    /// Degree K of the Legendre discrepancy (BM2), 0..=40.
+    #[arg(long, default_value_t = 9)]
+    k: usize,
+    /// Decay power p of the coefficient prior variance V0/(j+1)^p (0: the paper's prior).
+    #[arg(long, default_value_t = 0.0)]
+    prior_decay: f64,
+    /// Family of the coefficient prior.
+    #[arg(long, value_enum, default_value_t = PriorFamily::Laplace)]
+    prior_family: PriorFamily,
+    /// Only the MAP and its Laplace approximation, no sampling.
+    #[arg(long)]
+    map_only: bool,
+    #[command(flatten)]
+    run: RunArgs,
+    /// Output folder.
+    #[arg(long, default_value = "out/fit")]
+    out: PathBuf,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum PriorFamily {
+    Laplace,
+    Gaussian,
+}
+
+/// Options shared by every command that samples.
+#[derive(clap::Args, Clone)]
+struct RunArgs {
+    #[arg(long, value_enum, default_value_t = app::run::SamplerKind::AdaptiveMetropolis)]
+    sampler: app::run::SamplerKind,
+    #[arg(long, default_value_t = 4)]
+    chains: usize,
+    #[arg(long, default_value_t = 1000)]
+    warmup: usize,
+    #[arg(long, default_value_t = 1000)]
+    draws: usize,
+    /// Keep only the last N draws of each chain.
+    #[arg(long)]
+    keep: Option<usize>,
+    #[arg(long, default_value_t = motorcal::synthetic::DEFAULT_SEED)]
+    seed: u64,
+    /// Worker threads (default: all cores); draws do not depend on it.
+    #[arg(long)]
+    threads: Option<usize>,
+    /// No progress bars.
+    #[arg(long)]
+    quiet: bool,
+}
+
+impl RunArgs {
+    fn settings(&self) -> app::run::RunSettings {
+        app::run::RunSettings {
+            sampler: self.sampler,
+            chains: self.chains,
+            chain: motorcal::sampler::ChainSettings {
+                warmup: self.warmup,
+                draws: self.draws,
+                keep: self.keep,
+            },
+            seed: self.seed,
+            threads: self.threads,
+            quiet: self.quiet,
+            ..app::run::RunSettings::default()
+        }
+    }
+}
+
+fn fit(args: FitArgs) -> Result<(), AppError> {
+    use motorcal::bayes::{CoefficientFamily, ModelSettings};
+    if args.bm == 2 && args.k > motorcal::bayes::basis::MAX_LEGENDRE_DEGREE {
+        return Err(AppError::Usage(format!(
+            "--k {}: the discrepancy degree must be at most {}",
+            args.k,
+            motorcal::bayes::basis::MAX_LEGENDRE_DEGREE
+        )));
+    }
+    let mut settings = if args.bm == 1 {
+        ModelSettings::bm1()
+    } else {
+        ModelSettings::bm2(args.k)
+    };
+    settings.coefficient_prior.decay_power = args.prior_decay;
+    settings.coefficient_prior.family = match args.prior_family {
+        PriorFamily::Laplace => CoefficientFamily::Laplace,
+        PriorFamily::Gaussian => CoefficientFamily::Gaussian,
+    };
+    let options = app::fit::FitOptions {
+        data: args.data,
+        model: args.model,
+        settings,
+        run: (!args.map_only).then(|| args.run.settings()),
+        out: args.out,
+    };
+    let report = app::fit::fit(&options)?;
+    print!("{}", app::fit::format_report(&report));
+    Ok(())
+}
+
 fn table1(args: Table1Args) -> Result<(), AppError> {
     let options = app::table1::Table1Options {
         seed: args.seed,
@@ -101,18 +212,35 @@ fn table1(args: Table1Args) -> Result<(), AppError> {
     };
     let report = app::table1::reproduce_table1(&options)?;
     print!("{}", app::table1::format_report(&report));
-    println!("
-wrote {}/table1.json, table1.csv and the draws (CmdStan CSV)", options.out.display());
+    println!(
+        "
+wrote {}/table1.json, table1.csv and the draws (CmdStan CSV)",
+        options.out.display()
+    );
     Ok(())
 }
 
 fn run(cli: Cli) -> Result<(), AppError> {
     match cli.command {
         None => {
-            println!("motorcal: reproducing the paper's Table 1 (see `motorcal --help` for the other commands)\n");
-            table1(Table1Args { samplers: vec![app::run::SamplerKind::Metropolis, app::run::SamplerKind::AdaptiveMetropolis], chains: 3, seed: motorcal::synthetic::DEFAULT_SEED, out: PathBuf::from("out/table1"), ..Default::default() })
+            println!(
+                "motorcal: reproducing the paper's Table 1 (see `motorcal --help` for the other commands)\n"
+            );
+            table1(Table1Args {
+                samplers: vec![
+                    app::run::SamplerKind::Metropolis,
+                    app::run::SamplerKind::AdaptiveMetropolis,
+                ],
+                chains: 3,
+                seed: motorcal::synthetic::DEFAULT_SEED,
+                out: PathBuf::from("out/table1"),
+                ..Default::default()
+            })
         }
-        Some(Command::Reproduce { what: Reproduce::Table1(args) }) => table1(args),
+        Some(Command::Reproduce {
+            what: Reproduce::Table1(args),
+        }) => table1(args),
+        Some(Command::Fit(args)) => fit(args),
         Some(Command::Simulate {
             truth,
             nominal,

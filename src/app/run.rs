@@ -15,8 +15,8 @@ use crate::density::{DensityError, LogDensity};
 use crate::diagnostics::{ParameterSummary, summarize};
 use crate::io::{CmdStanWriter, SamplerColumns};
 use crate::optimize::{MapEstimate, MapSettings, find_map};
-use crate::sampler::driver::chain_rng;
 use crate::sampler::adaptive_metropolis::{AdaptiveMetropolis, HaarioAdaptation};
+use crate::sampler::driver::chain_rng;
 use crate::sampler::metropolis::{Metropolis, PyMc3Tuning};
 use crate::sampler::{Adaptation, ChainOutput, ChainSettings, Kernel, run_chains};
 
@@ -305,7 +305,8 @@ fn dispatch(
         SamplerKind::AdaptiveMetropolis => execute(posterior, inits, settings, label, |_| {
             // Started from the Laplace covariance: the posterior's scales span ten orders of
             // magnitude, which an isotropic start would spend the warm-up discovering.
-            let kernel = AdaptiveMetropolis::from_precision(&map.hessian).map_err(DensityError::fatal)?;
+            let kernel =
+                AdaptiveMetropolis::from_precision(&map.hessian).map_err(DensityError::fatal)?;
             Ok((kernel, HaarioAdaptation::default()))
         }),
     }

@@ -14,7 +14,10 @@ use super::run::{RunOutput, RunSettings, SamplerKind, run_sampler, write_draws};
 use super::{AppError, provenance};
 
 /// Table 1 of the paper (posterior means), quoted for comparison only.
-pub const PAPER_TABLE1: [(&str, [f64; 3]); 2] = [("BM1", [9.03e-2, 6.29, 10.3]), ("BM2(K=9)", [9.92e-2, 2.02, 9.95])];
+pub const PAPER_TABLE1: [(&str, [f64; 3]); 2] = [
+    ("BM1", [9.03e-2, 6.29, 10.3]),
+    ("BM2(K=9)", [9.92e-2, 2.02, 9.95]),
+];
 /// §4.2: relative L² error of the posterior-mean δ against d0, for I and ω (K = 9).
 pub const PAPER_DISCREPANCY_ERROR: [f64; 2] = [0.10, 0.092];
 
@@ -82,9 +85,21 @@ pub struct Table1Report {
 /// BM1 1500 draws keeping the last 700, BM2 100000 draws keeping the last 40000.
 pub fn paper_protocol(bm2: bool, quick: bool) -> ChainSettings {
     match (bm2, quick) {
-        (false, _) => ChainSettings { warmup: 500, draws: 1500, keep: Some(700) },
-        (true, false) => ChainSettings { warmup: 500, draws: 100_000, keep: Some(40_000) },
-        (true, true) => ChainSettings { warmup: 500, draws: 10_000, keep: Some(4_000) },
+        (false, _) => ChainSettings {
+            warmup: 500,
+            draws: 1500,
+            keep: Some(700),
+        },
+        (true, false) => ChainSettings {
+            warmup: 500,
+            draws: 100_000,
+            keep: Some(40_000),
+        },
+        (true, true) => ChainSettings {
+            warmup: 500,
+            draws: 10_000,
+            keep: Some(4_000),
+        },
     }
 }
 
@@ -97,9 +112,21 @@ pub fn protocol(sampler: SamplerKind, bm2: bool, quick: bool) -> ChainSettings {
     match sampler {
         SamplerKind::Metropolis => paper_protocol(bm2, quick),
         SamplerKind::AdaptiveMetropolis => match (bm2, quick) {
-            (false, _) => ChainSettings { warmup: 1000, draws: 10_000, keep: None },
-            (true, false) => ChainSettings { warmup: 5000, draws: 100_000, keep: Some(40_000) },
-            (true, true) => ChainSettings { warmup: 5000, draws: 10_000, keep: Some(4_000) },
+            (false, _) => ChainSettings {
+                warmup: 1000,
+                draws: 10_000,
+                keep: None,
+            },
+            (true, false) => ChainSettings {
+                warmup: 5000,
+                draws: 100_000,
+                keep: Some(40_000),
+            },
+            (true, true) => ChainSettings {
+                warmup: 5000,
+                draws: 10_000,
+                keep: Some(4_000),
+            },
         },
     }
 }
@@ -109,7 +136,11 @@ fn relative_error(estimate: f64, reference: f64) -> f64 {
 }
 
 /// ‖E[δ] − d0‖/‖d0‖ per channel from the posterior mean of the coefficients.
-fn discrepancy_errors(posterior: &CalibrationPosterior, run: &RunOutput, d0: &[Vec<f64>]) -> Option<[f64; 2]> {
+fn discrepancy_errors(
+    posterior: &CalibrationPosterior,
+    run: &RunOutput,
+    d0: &[Vec<f64>],
+) -> Option<[f64; 2]> {
     let mut mean = vec![0.0; posterior.dim_of_outputs()];
     for (j, s) in run.summaries.iter().enumerate() {
         mean[j] = s.mean;
@@ -127,11 +158,20 @@ fn discrepancy_errors(posterior: &CalibrationPosterior, run: &RunOutput, d0: &[V
 
 pub fn reproduce_table1(options: &Table1Options) -> Result<Table1Report, AppError> {
     if options.samplers.is_empty() {
-        return Err(AppError::Usage("--samplers: name at least one sampler".into()));
+        return Err(AppError::Usage(
+            "--samplers: name at least one sampler".into(),
+        ));
     }
     let problem = Problem::paper(options.seed)?;
-    let reference = problem.reference.clone().expect("the paper's problem has a reference");
-    let truth = [reference.truth.resistance, reference.noise_sd[0], reference.noise_sd[1]];
+    let reference = problem
+        .reference
+        .clone()
+        .expect("the paper's problem has a reference");
+    let truth = [
+        reference.truth.resistance,
+        reference.noise_sd[0],
+        reference.noise_sd[1],
+    ];
     let mut rows = Vec::new();
     let mut metadata = provenance();
     metadata.push(("seed".into(), options.seed.to_string()));
@@ -152,11 +192,56 @@ pub fn reproduce_table1(options: &Table1Options) -> Result<Table1Report, AppErro
             let run = run_sampler(&mut posterior, &run_settings, &settings.label())?;
             let mean = |name: &str| run.summary(name).map_or(f64::NAN, |s| s.mean);
             let means = [mean("R"), mean("sigma_I"), mean("sigma_omega")];
-            let discrepancy_rel_error = if bm2 { discrepancy_errors(&posterior, &run, &reference.discrepancy) } else { None };
+            let discrepancy_rel_error = if bm2 {
+                discrepancy_errors(&posterior, &run, &reference.discrepancy)
+            } else {
+                None
+            };
             let mut meta = metadata.clone();
             meta.push(("model".into(), settings.label()));
-            meta.push(("settings".into(), serde_json::to_string(&run_settings).unwrap_or_default()));
-            write_draws(&options.out, &settings.label().replace(['(', ')', '='], "").to_lowercase(), &run, &meta)?;
+            meta.push((
+                "settings".into(),
+                serde_json::to_string(&run_settings).unwrap_or_default(),
+            ));
+            let prefix = settings.label().replace(['(', ')', '='], "").to_lowercase();
+            write_draws(&options.out, &prefix, &run, &meta)?;
+            let title = format!(
+                "{} — {} ({} chains)",
+                settings.label(),
+                run.sampler,
+                options.chains
+            );
+            super::predictive::plot_traces(
+                &options
+                    .out
+                    .join(format!("traces-{prefix}-{}.png", run.sampler)),
+                &title,
+                &run.chains,
+                &[
+                    ("R", Some(truth[0])),
+                    ("sigma_I", Some(truth[1])),
+                    ("sigma_omega", Some(truth[2])),
+                ],
+            )?;
+            if bm2 {
+                let predictive =
+                    super::predictive::posterior_predictive(&mut posterior, &run.chains)?;
+                super::predictive::plot_discrepancy(
+                    &options
+                        .out
+                        .join(format!("discrepancy-{prefix}-{}.png", run.sampler)),
+                    &format!("δ of {title}; dashed: the reference d0"),
+                    &predictive,
+                    Some(&reference.discrepancy),
+                )?;
+                super::predictive::plot_predictive(
+                    &options
+                        .out
+                        .join(format!("predictive-{prefix}-{}.png", run.sampler)),
+                    &title,
+                    &predictive,
+                )?;
+            }
             rows.push(Table1Row {
                 model: settings.label(),
                 sampler: run.sampler.clone(),
@@ -196,7 +281,9 @@ fn write_report(dir: &Path, report: &Table1Report) -> Result<(), AppError> {
         "model,sampler,warmup,draws,kept,chains,mean_R,mean_sigma_I,mean_sigma_omega,rel_err_R,rel_err_sigma_I,rel_err_sigma_omega,delta_rel_err_I,delta_rel_err_omega,max_rhat,min_ess_bulk,wall_s,converged\n",
     );
     for r in &report.rows {
-        let (di, dw) = r.discrepancy_rel_error.map_or((f64::NAN, f64::NAN), |d| (d[0], d[1]));
+        let (di, dw) = r
+            .discrepancy_rel_error
+            .map_or((f64::NAN, f64::NAN), |d| (d[0], d[1]));
         csv.push_str(&format!(
             "{},{},{},{},{},{},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{},{},{},{}\n",
             r.model,
@@ -232,15 +319,33 @@ pub fn format_report(report: &Table1Report) -> String {
     ));
     out.push_str(&format!(
         "{:<10} {:<20} {:>10} {:>9} {:>9} {:>9} {:>9} {:>9} {:>13} {:>7} {:>8} {:>7}\n",
-        "model", "sampler", "R", "sigma_I", "sigma_w", "err R", "err s_I", "err s_w", "err delta I/w", "R-hat", "min ESS", "wall s"
+        "model",
+        "sampler",
+        "R",
+        "sigma_I",
+        "sigma_w",
+        "err R",
+        "err s_I",
+        "err s_w",
+        "err delta I/w",
+        "R-hat",
+        "min ESS",
+        "wall s"
     ));
     for (model, means) in PAPER_TABLE1 {
         let truth = [0.1, 2.0, 10.0];
-        let e: Vec<f64> = means.iter().zip(truth).map(|(m, t)| relative_error(*m, t)).collect();
+        let e: Vec<f64> = means
+            .iter()
+            .zip(truth)
+            .map(|(m, t)| relative_error(*m, t))
+            .collect();
         let delta = if model == "BM1" {
             "".to_string()
         } else {
-            format!("{:.3}/{:.3}", PAPER_DISCREPANCY_ERROR[0], PAPER_DISCREPANCY_ERROR[1])
+            format!(
+                "{:.3}/{:.3}",
+                PAPER_DISCREPANCY_ERROR[0], PAPER_DISCREPANCY_ERROR[1]
+            )
         };
         out.push_str(&format!(
             "{:<10} {:<20} {:>10.3e} {:>9.3} {:>9.3} {:>9.2e} {:>9.2e} {:>9.2e} {:>13} {:>7} {:>8} {:>7}\n",
@@ -248,7 +353,9 @@ pub fn format_report(report: &Table1Report) -> String {
         ));
     }
     for r in &report.rows {
-        let delta = r.discrepancy_rel_error.map_or(String::new(), |d| format!("{:.3}/{:.3}", d[0], d[1]));
+        let delta = r
+            .discrepancy_rel_error
+            .map_or(String::new(), |d| format!("{:.3}/{:.3}", d[0], d[1]));
         out.push_str(&format!(
             "{:<10} {:<20} {:>10.3e} {:>9.3} {:>9.3} {:>9.2e} {:>9.2e} {:>9.2e} {:>13} {:>7.3} {:>8.0} {:>7.1}{}\n",
             r.model,

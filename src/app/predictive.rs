@@ -1,0 +1,234 @@
+//! What a fit predicts: G(θ) + δ with its credible band per channel, residuals, and the figures
+//! made from them.
+
+use std::path::Path;
+
+use crate::bayes::CalibrationPosterior;
+use crate::plot::{self, ChannelPrediction, DiscrepancyBand, PredictivePlot, TraceSeries};
+use crate::sampler::ChainOutput;
+
+use super::AppError;
+
+/// Draws used for bands: enough for stable 95% quantiles, few enough to solve the ODE for each.
+const BAND_DRAWS: usize = 400;
+
+/// Per channel, at every sample time.
+#[derive(Clone, Debug)]
+pub struct ChannelPredictive {
+    pub name: String,
+    pub unit: String,
+    pub measured: Vec<f64>,
+    /// G at the posterior mean of θ.
+    pub model: Vec<f64>,
+    /// Posterior mean of G(θ) + δ and its 95% band.
+    pub mean: Vec<f64>,
+    pub lower: Vec<f64>,
+    pub upper: Vec<f64>,
+    /// Posterior mean of δ and its 95% band.
+    pub discrepancy_mean: Vec<f64>,
+    pub discrepancy_lower: Vec<f64>,
+    pub discrepancy_upper: Vec<f64>,
+    /// Posterior mean of the channel's noise σ.
+    pub sigma: f64,
+}
+
+#[derive(Clone, Debug)]
+pub struct Predictive {
+    pub times: Vec<f64>,
+    pub channels: Vec<ChannelPredictive>,
+}
+
+fn unit_of(channel: &str) -> &'static str {
+    match channel {
+        "I" => "A",
+        "omega" => "rad/s",
+        _ => "",
+    }
+}
+
+fn quantile(sorted: &[f64], q: f64) -> f64 {
+    let h = (sorted.len() - 1) as f64 * q;
+    let (lo, hi) = (h.floor() as usize, h.ceil() as usize);
+    sorted[lo] + (h - lo as f64) * (sorted[hi] - sorted[lo])
+}
+
+/// The posterior predictive of the first recording from the chains' unconstrained draws.
+pub fn posterior_predictive(
+    posterior: &mut CalibrationPosterior,
+    chains: &[ChainOutput],
+) -> Result<Predictive, AppError> {
+    let all: Vec<&Vec<f64>> = chains.iter().flat_map(|c| c.unconstrained.iter()).collect();
+    if all.is_empty() {
+        return Err(AppError::Numerical("no draws to predict from".into()));
+    }
+    let stride = (all.len() / BAND_DRAWS).max(1);
+    let picked: Vec<&Vec<f64>> = all.iter().step_by(stride).copied().collect();
+    let d = all[0].len();
+    let mut mean_x = vec![0.0; d];
+    for x in &all {
+        for (m, v) in mean_x.iter_mut().zip(x.iter()) {
+            *m += v / all.len() as f64;
+        }
+    }
+    let times = posterior.forward(0).times().to_vec();
+    let m = times.len();
+    let names: Vec<String> = posterior
+        .forward(0)
+        .channels()
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    let model_at_mean = posterior.simulate(&mean_x, 0)?;
+    // totals[c][draw][i] and discrepancies likewise
+    let mut totals = vec![Vec::with_capacity(picked.len()); names.len()];
+    let mut deltas = vec![Vec::with_capacity(picked.len()); names.len()];
+    for x in &picked {
+        let g = posterior.simulate(x, 0)?;
+        for c in 0..names.len() {
+            let delta = posterior.discrepancy(x, 0, c);
+            totals[c].push(
+                (0..m)
+                    .map(|i| g[c * m + i] + delta[i])
+                    .collect::<Vec<f64>>(),
+            );
+            deltas[c].push(delta);
+        }
+    }
+    let band = |rows: &[Vec<f64>]| {
+        let mut mean = vec![0.0; m];
+        let mut lower = vec![0.0; m];
+        let mut upper = vec![0.0; m];
+        let mut column = vec![0.0; rows.len()];
+        for i in 0..m {
+            for (k, r) in rows.iter().enumerate() {
+                column[k] = r[i];
+            }
+            mean[i] = column.iter().sum::<f64>() / rows.len() as f64;
+            column.sort_by(|a, b| a.total_cmp(b));
+            lower[i] = quantile(&column, 0.025);
+            upper[i] = quantile(&column, 0.975);
+        }
+        (mean, lower, upper)
+    };
+    let mut channels = Vec::new();
+    for (c, name) in names.iter().enumerate() {
+        let (mean, lower, upper) = band(&totals[c]);
+        let (dm, dl, du) = band(&deltas[c]);
+        let si = posterior.log_sigma_index(0, c);
+        let sigma = all.iter().map(|x| x[si].exp()).sum::<f64>() / all.len() as f64;
+        channels.push(ChannelPredictive {
+            name: name.clone(),
+            unit: unit_of(name).into(),
+            measured: posterior.observed(0, c).to_vec(),
+            model: model_at_mean[c * m..(c + 1) * m].to_vec(),
+            mean,
+            lower,
+            upper,
+            discrepancy_mean: dm,
+            discrepancy_lower: dl,
+            discrepancy_upper: du,
+            sigma,
+        });
+    }
+    Ok(Predictive { times, channels })
+}
+
+/// `predictive.csv`: one row per channel and time.
+pub fn write_predictive_csv(path: &Path, p: &Predictive) -> Result<(), AppError> {
+    let mut text = String::from(
+        "channel,t,measured,model_at_mean,mean,lower_95,upper_95,residual,discrepancy_mean,discrepancy_lower_95,discrepancy_upper_95\n",
+    );
+    for ch in &p.channels {
+        for (i, t) in p.times.iter().enumerate() {
+            text.push_str(&format!(
+                "{},{t:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?}\n",
+                ch.name,
+                ch.measured[i],
+                ch.model[i],
+                ch.mean[i],
+                ch.lower[i],
+                ch.upper[i],
+                ch.measured[i] - ch.mean[i],
+                ch.discrepancy_mean[i],
+                ch.discrepancy_lower[i],
+                ch.discrepancy_upper[i]
+            ));
+        }
+    }
+    crate::io::write_atomically(path, text.as_bytes())?;
+    Ok(())
+}
+
+fn plot_error(e: plot::PlotError) -> AppError {
+    AppError::Output(e.to_string())
+}
+
+/// The data with the fit and its band, and the residuals.
+pub fn plot_predictive(path: &Path, title: &str, p: &Predictive) -> Result<(), AppError> {
+    let plot = PredictivePlot {
+        title: title.into(),
+        times: p.times.clone(),
+        channels: p
+            .channels
+            .iter()
+            .map(|c| ChannelPrediction {
+                name: c.name.clone(),
+                unit: c.unit.clone(),
+                measured: c.measured.clone(),
+                model: c.model.clone(),
+                mean: c.mean.clone(),
+                lower: c.lower.clone(),
+                upper: c.upper.clone(),
+                sigma: c.sigma,
+            })
+            .collect(),
+    };
+    plot::posterior_predictive(path, &plot).map_err(plot_error)
+}
+
+/// δ with its band, and the reference discrepancy where it is known (Figures 13/16).
+pub fn plot_discrepancy(
+    path: &Path,
+    title: &str,
+    p: &Predictive,
+    reference: Option<&[Vec<f64>]>,
+) -> Result<(), AppError> {
+    let bands: Vec<DiscrepancyBand> = p
+        .channels
+        .iter()
+        .enumerate()
+        .map(|(c, ch)| DiscrepancyBand {
+            name: ch.name.clone(),
+            unit: ch.unit.clone(),
+            mean: ch.discrepancy_mean.clone(),
+            lower: ch.discrepancy_lower.clone(),
+            upper: ch.discrepancy_upper.clone(),
+            reference: reference.map(|r| r[c].clone()),
+        })
+        .collect();
+    plot::discrepancy_band(path, title, &p.times, &bands).map_err(plot_error)
+}
+
+/// Trace plots of the named quantities (Figures 6/12/15), with reference values where known.
+pub fn plot_traces(
+    path: &Path,
+    title: &str,
+    chains: &[ChainOutput],
+    names: &[(&str, Option<f64>)],
+) -> Result<(), AppError> {
+    let Some(first) = chains.first() else {
+        return Err(AppError::Numerical("no chains".into()));
+    };
+    let series: Vec<TraceSeries> = names
+        .iter()
+        .filter_map(|(name, reference)| {
+            let j = first.names.iter().position(|n| n == name)?;
+            Some(TraceSeries {
+                name: name.to_string(),
+                chains: chains.iter().map(|c| c.column(j)).collect(),
+                reference: *reference,
+            })
+        })
+        .collect();
+    plot::traces(path, title, &series).map_err(plot_error)
+}

@@ -1,0 +1,224 @@
+//! The command line as a user meets it: the README's commands work, and bad input gets one
+//! clear error line, a non-zero exit and no output.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn motorcal(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_motorcal"))
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("motorcal-cli-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn assert_clean_failure(o: &Output, needles: &[&str]) {
+    assert!(
+        !o.status.success(),
+        "expected failure, got success: {}",
+        String::from_utf8_lossy(&o.stdout)
+    );
+    let err = stderr(o);
+    let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert_eq!(lines.len(), 1, "expected one error line, got: {err}");
+    assert!(!err.contains("panicked"), "{err}");
+    for needle in needles {
+        assert!(
+            err.contains(needle),
+            "error '{err}' does not mention '{needle}'"
+        );
+    }
+}
+
+fn simulate_into(dir: &Path) {
+    let o = motorcal(&[
+        "simulate",
+        "--out",
+        dir.to_str().unwrap(),
+        "--seed",
+        "3",
+        "--input",
+        "reversal",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+#[test]
+fn simulate_then_fit_map_writes_a_report() {
+    let dir = scratch("fit");
+    simulate_into(&dir);
+    for f in ["recording.csv", "motor.toml", "truth.toml"] {
+        assert!(dir.join(f).exists(), "{f} missing");
+    }
+    let out = dir.join("out");
+    let o = motorcal(&[
+        "fit",
+        "--data",
+        dir.join("recording.csv").to_str().unwrap(),
+        "--model",
+        dir.join("motor.toml").to_str().unwrap(),
+        "--map-only",
+        "--k",
+        "5",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("fit.json")).unwrap()).unwrap();
+    let r = report["map"][0]["value"].as_f64().unwrap();
+    assert!((r - 0.1).abs() < 0.01, "MAP of R = {r}");
+}
+
+#[test]
+fn a_fit_with_a_sampler_writes_draws_that_summarize_reads_back() {
+    let dir = scratch("sample");
+    simulate_into(&dir);
+    let out = dir.join("out");
+    let o = motorcal(&[
+        "fit",
+        "--data",
+        dir.join("recording.csv").to_str().unwrap(),
+        "--model",
+        dir.join("motor.toml").to_str().unwrap(),
+        "--bm",
+        "1",
+        "--sampler",
+        "adaptive-metropolis",
+        "--chains",
+        "2",
+        "--warmup",
+        "300",
+        "--draws",
+        "300",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    for f in ["predictive.csv", "predictive.png", "traces.png", "fit.json"] {
+        assert!(out.join(f).exists(), "{f} missing");
+    }
+    let draws: Vec<String> = (1..=2)
+        .map(|c| {
+            out.join(format!("fit-adaptive-metropolis-chain{c}.csv"))
+                .display()
+                .to_string()
+        })
+        .collect();
+    let mut args = vec!["summarize"];
+    args.extend(draws.iter().map(|s| s.as_str()));
+    let o = motorcal(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        text.contains("2 chains × 300 draws") && text.contains("sigma_omega"),
+        "{text}"
+    );
+}
+
+#[test]
+fn an_unknown_key_in_the_model_file_names_file_line_and_field() {
+    let dir = scratch("badtoml");
+    simulate_into(&dir);
+    let model = dir.join("bad.toml");
+    std::fs::write(&model, "[motor]\nR = 0.1\nc_q = 3\n").unwrap();
+    let out = dir.join("out");
+    let o = motorcal(&[
+        "fit",
+        "--data",
+        dir.join("recording.csv").to_str().unwrap(),
+        "--model",
+        model.to_str().unwrap(),
+        "--map-only",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_clean_failure(&o, &["bad.toml", ":3", "c_q"]);
+    assert!(!out.exists(), "a failed run wrote output");
+}
+
+#[test]
+fn a_non_positive_inductance_is_refused() {
+    let dir = scratch("badl");
+    simulate_into(&dir);
+    let model = dir.join("bad.toml");
+    std::fs::write(&model, "[motor]\nL = -1e-4\n").unwrap();
+    let o = motorcal(&[
+        "fit",
+        "--data",
+        dir.join("recording.csv").to_str().unwrap(),
+        "--model",
+        model.to_str().unwrap(),
+        "--map-only",
+    ]);
+    assert_clean_failure(&o, &["bad.toml", "L"]);
+}
+
+#[test]
+fn time_going_backwards_in_a_recording_names_the_line() {
+    let dir = scratch("badcsv");
+    simulate_into(&dir);
+    let csv = dir.join("bad.csv");
+    std::fs::write(&csv, "t,I,omega\n0.1,1,2\n0.2,1,2\n0.15,1,2\n0.3,1,2\n").unwrap();
+    let o = motorcal(&[
+        "fit",
+        "--data",
+        csv.to_str().unwrap(),
+        "--model",
+        dir.join("motor.toml").to_str().unwrap(),
+        "--map-only",
+    ]);
+    assert_clean_failure(&o, &["bad.csv", ":4", "t"]);
+}
+
+#[test]
+fn a_nan_cell_names_its_column() {
+    let dir = scratch("nan");
+    simulate_into(&dir);
+    let csv = dir.join("nan.csv");
+    std::fs::write(&csv, "t,I,omega\n0.1,1,2\n0.2,NaN,2\n").unwrap();
+    let o = motorcal(&[
+        "fit",
+        "--data",
+        csv.to_str().unwrap(),
+        "--model",
+        dir.join("motor.toml").to_str().unwrap(),
+        "--map-only",
+    ]);
+    assert_clean_failure(&o, &["nan.csv", ":3", "I"]);
+}
+
+#[test]
+fn impossible_options_are_refused_before_any_work() {
+    let dir = scratch("opts");
+    simulate_into(&dir);
+    let data = dir.join("recording.csv");
+    let model = dir.join("motor.toml");
+    let base = [
+        "fit",
+        "--data",
+        data.to_str().unwrap(),
+        "--model",
+        model.to_str().unwrap(),
+    ];
+    let run = |extra: &[&str]| {
+        let mut args: Vec<&str> = base.to_vec();
+        args.extend_from_slice(extra);
+        motorcal(&args)
+    };
+    assert_clean_failure(&run(&["--k", "41"]), &["--k 41"]);
+    assert_clean_failure(&run(&["--chains", "0"]), &["--chains 0"]);
+    assert_clean_failure(&run(&["--draws", "100", "--keep", "200"]), &["keep 200"]);
+    assert_clean_failure(&run(&["--threads", "0"]), &["--threads 0"]);
+}
