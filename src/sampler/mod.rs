@@ -5,8 +5,12 @@
 //! adaptation watches the `Info`s during warm-up and retunes the kernel's parameters, then
 //! freezes them. The driver knows neither's internals.
 
+pub mod adapt;
 pub mod adaptive_metropolis;
 pub mod driver;
+pub mod hmc;
+pub mod metric;
+pub mod nuts;
 pub mod metropolis;
 pub mod fisher_mala;
 pub mod mala;

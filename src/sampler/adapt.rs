@@ -1,0 +1,504 @@
+//! Warm-up of the Hamiltonian kernels as in Stan: dual averaging of the step size (Hoffman &
+//! Gelman 2014, §3.2) and a windowed estimate of the metric from the chain's own draws, with
+//! dual averaging restarted after each window. Works on any kernel that exposes its step size
+//! and metric ([`HamiltonianKernel`]), so HMC and NUTS share it.
+
+use std::ops::Range;
+
+use nalgebra::DMatrix;
+use serde::{Deserialize, Serialize};
+
+use super::metric::{Metric, MetricKind};
+use super::{Adaptation, Info, State};
+
+/// A kernel whose step size and Euclidean metric warm-up can tune.
+pub trait HamiltonianKernel {
+    fn step_size(&self) -> f64;
+    fn step_size_mut(&mut self) -> &mut f64;
+    fn metric(&self) -> &Metric;
+    fn metric_mut(&mut self) -> &mut Metric;
+    /// Whether Stan's step-size heuristic runs before the next transition (it needs the
+    /// density and the random stream, which only a transition has); cleared once it ran.
+    fn search_pending_mut(&mut self) -> &mut bool;
+}
+
+/// What warm-up tuned: enough to resume sampling later without warm-up (with
+/// [`NoAdaptation`](super::NoAdaptation)) or to warm-start another run.
+///
+/// Save it as TOML ([`AdaptationState::to_toml`]) for a bit-exact round trip: `toml` parses
+/// floats exactly, while `serde_json` without its `float_roundtrip` feature may change the last
+/// bit of a number, and with it every draw after.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "AdaptationStateRepr")]
+pub struct AdaptationState {
+    pub step_size: f64,
+    pub metric: Metric,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct AdaptationStateRepr {
+    step_size: f64,
+    metric: Metric,
+}
+
+impl TryFrom<AdaptationStateRepr> for AdaptationState {
+    type Error = String;
+
+    fn try_from(repr: AdaptationStateRepr) -> Result<Self, String> {
+        if !(repr.step_size > 0.0 && repr.step_size.is_finite()) {
+            return Err(format!(
+                "step_size must be positive and finite, got {}",
+                repr.step_size
+            ));
+        }
+        Ok(Self {
+            step_size: repr.step_size,
+            metric: repr.metric,
+        })
+    }
+}
+
+impl AdaptationState {
+    /// The kernel's current tuning.
+    pub fn of<K: HamiltonianKernel>(kernel: &K) -> Self {
+        Self {
+            step_size: kernel.step_size(),
+            metric: kernel.metric().clone(),
+        }
+    }
+
+    /// Gives a kernel this tuning (cancelling any pending step-size search).
+    pub fn apply_to<K: HamiltonianKernel>(&self, kernel: &mut K) -> Result<(), String> {
+        if kernel.metric().dim() != self.metric.dim() {
+            return Err(format!(
+                "the saved metric is {}-dimensional, the kernel's {}-dimensional",
+                self.metric.dim(),
+                kernel.metric().dim()
+            ));
+        }
+        *kernel.step_size_mut() = self.step_size;
+        *kernel.metric_mut() = self.metric.clone();
+        *kernel.search_pending_mut() = false;
+        Ok(())
+    }
+
+    pub fn to_toml(&self) -> String {
+        toml::to_string(self).expect("an adaptation state always serialises to TOML")
+    }
+
+    pub fn from_toml(text: &str) -> Result<Self, String> {
+        toml::from_str(text).map_err(|e| e.message().to_string())
+    }
+}
+
+/// Dual averaging of log ε towards a target mean acceptance statistic.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct DualAveragingSettings {
+    /// δ, the target of the mean `accept_stat`.
+    pub target_accept: f64,
+    /// γ: how strongly log ε is pulled towards μ = log(10 ε₀).
+    pub gamma: f64,
+    /// t₀: damps the first iterations.
+    pub t0: f64,
+    /// κ: how fast the averaged iterate forgets early ones.
+    pub kappa: f64,
+}
+
+impl Default for DualAveragingSettings {
+    fn default() -> Self {
+        Self {
+            target_accept: 0.8,
+            gamma: 0.05,
+            t0: 10.0,
+            kappa: 0.75,
+        }
+    }
+}
+
+impl DualAveragingSettings {
+    pub fn validate(&self) -> Result<(), String> {
+        if !(self.target_accept > 0.0 && self.target_accept < 1.0) {
+            return Err(format!(
+                "the target acceptance must be in (0, 1), got {}",
+                self.target_accept
+            ));
+        }
+        if !(self.gamma > 0.0 && self.t0 >= 0.0 && self.kappa > 0.0 && self.kappa <= 1.0) {
+            return Err(format!(
+                "dual averaging needs γ > 0, t0 ≥ 0 and κ in (0, 1], got γ = {}, t0 = {}, κ = {}",
+                self.gamma, self.t0, self.kappa
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The dual-averaging iteration: the current iterate x is what the next transitions use, the
+/// average x̄ what sampling uses.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DualAveraging {
+    settings: DualAveragingSettings,
+    mu: f64,
+    counter: f64,
+    s_bar: f64,
+    x: f64,
+    x_bar: f64,
+}
+
+impl DualAveraging {
+    /// Starts at ε₀ with μ = log(10 ε₀): a bias towards larger steps, which are cheaper.
+    pub fn new(settings: &DualAveragingSettings, initial_step_size: f64) -> Self {
+        Self {
+            settings: settings.clone(),
+            mu: (10.0 * initial_step_size).ln(),
+            counter: 0.0,
+            s_bar: 0.0,
+            x: initial_step_size.ln(),
+            x_bar: 0.0,
+        }
+    }
+
+    /// Learns from one transition's `accept_stat`; returns the step size for the next one.
+    pub fn update(&mut self, accept_stat: f64) -> f64 {
+        let s = &self.settings;
+        // A NaN statistic says as little as a zero one: shrink.
+        let accept = if accept_stat.is_nan() {
+            0.0
+        } else {
+            accept_stat.min(1.0)
+        };
+        self.counter += 1.0;
+        let eta = 1.0 / (self.counter + s.t0);
+        self.s_bar = (1.0 - eta) * self.s_bar + eta * (s.target_accept - accept);
+        self.x = self.mu - self.s_bar * self.counter.sqrt() / s.gamma;
+        let weight = self.counter.powf(-s.kappa);
+        self.x_bar = (1.0 - weight) * self.x_bar + weight * self.x;
+        self.x.exp()
+    }
+
+    /// The step size of the latest iterate.
+    pub fn step_size(&self) -> f64 {
+        self.x.exp()
+    }
+
+    /// The averaged step size, for sampling.
+    pub fn final_step_size(&self) -> f64 {
+        self.x_bar.exp()
+    }
+}
+
+/// Step-size adaptation only (for a metric known in advance, e.g. from the MAP Hessian).
+#[derive(Clone, Debug)]
+pub struct StepSizeAdaptation {
+    settings: DualAveragingSettings,
+    dual: Option<DualAveraging>,
+    restart_pending: bool,
+}
+
+impl StepSizeAdaptation {
+    pub fn new(settings: DualAveragingSettings) -> Result<Self, String> {
+        settings.validate()?;
+        Ok(Self {
+            settings,
+            dual: None,
+            restart_pending: true,
+        })
+    }
+
+    /// Restarts dual averaging at the step size of the next transition (after the kernel has
+    /// searched a new one for a new metric).
+    fn restart(&mut self) {
+        self.restart_pending = true;
+    }
+
+    fn observe_step<K: HamiltonianKernel>(&mut self, kernel: &mut K, info: &Info) {
+        if self.restart_pending || self.dual.is_none() {
+            self.dual = Some(DualAveraging::new(&self.settings, info.step_size));
+            self.restart_pending = false;
+        }
+        let dual = self.dual.as_mut().expect("just set");
+        *kernel.step_size_mut() = dual.update(info.accept_stat);
+    }
+
+    fn finish_step<K: HamiltonianKernel>(&mut self, kernel: &mut K) {
+        if let Some(dual) = &self.dual {
+            *kernel.step_size_mut() = dual.final_step_size();
+        }
+        // Sampling must run with the averaged step size, not a fresh search's.
+        *kernel.search_pending_mut() = false;
+    }
+}
+
+impl Default for StepSizeAdaptation {
+    fn default() -> Self {
+        Self::new(DualAveragingSettings::default()).expect("the defaults are valid")
+    }
+}
+
+impl<K: HamiltonianKernel> Adaptation<K> for StepSizeAdaptation {
+    fn observe(&mut self, kernel: &mut K, _: &State, info: &Info, _: usize, _: usize) {
+        self.observe_step(kernel, info);
+    }
+
+    fn finish(&mut self, kernel: &mut K) {
+        self.finish_step(kernel);
+    }
+}
+
+/// Stan's warm-up schedule: an initial buffer where only the step size adapts (the chain
+/// travels to the typical set), then metric windows of doubling length, each estimating the
+/// metric afresh from its own draws, then a terminal buffer where the step size adapts to the
+/// last metric.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct WarmupSchedule {
+    /// The warm-up iterations whose draws each metric estimate uses; the metric is updated
+    /// after the last iteration of each.
+    pub windows: Vec<Range<usize>>,
+}
+
+impl WarmupSchedule {
+    /// Stan's windows for `n_warmup` iterations: windows of `base_window`, 2·`base_window`, …
+    /// after `init_buffer` iterations, the last one stretched to end `term_buffer` iterations
+    /// before the end of warm-up when the next doubling would not fit. With fewer than
+    /// init + base + term iterations the buffers shrink to 15 % and 10 % of warm-up and one
+    /// window takes the rest; below 20 iterations the metric is not adapted. As in Stan, the
+    /// first window is never stretched, so a short remainder can make a short last window
+    /// (160 iterations: windows of 25 and 10).
+    pub fn stan(
+        n_warmup: usize,
+        init_buffer: usize,
+        term_buffer: usize,
+        base_window: usize,
+    ) -> Self {
+        if n_warmup < 20 {
+            return Self {
+                windows: Vec::new(),
+            };
+        }
+        let (init_buffer, term_buffer, base_window) =
+            if init_buffer + base_window + term_buffer > n_warmup {
+                let init = (0.15 * n_warmup as f64) as usize;
+                let term = (0.1 * n_warmup as f64) as usize;
+                (init, term, n_warmup - init - term)
+            } else {
+                (init_buffer, term_buffer, base_window)
+            };
+        let last = n_warmup - term_buffer - 1;
+        let mut windows = Vec::new();
+        let mut size = base_window;
+        let mut start = init_buffer;
+        let mut end = init_buffer + base_window - 1;
+        loop {
+            windows.push(start..end + 1);
+            if end >= last {
+                break;
+            }
+            start = end + 1;
+            size *= 2;
+            end += size;
+            if end + 2 * size >= n_warmup - term_buffer {
+                end = last;
+            }
+        }
+        Self { windows }
+    }
+
+    fn collects(&self, iteration: usize) -> bool {
+        match (self.windows.first(), self.windows.last()) {
+            (Some(first), Some(last)) => first.start <= iteration && iteration < last.end,
+            _ => false,
+        }
+    }
+
+    fn ends_window(&self, iteration: usize) -> bool {
+        self.windows.iter().any(|w| w.end == iteration + 1)
+    }
+}
+
+/// Settings of Stan's warm-up.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct AdaptationSettings {
+    pub step_size: DualAveragingSettings,
+    /// Estimate the metric in windows (otherwise only the step size adapts).
+    pub adapt_metric: bool,
+    pub init_buffer: usize,
+    pub term_buffer: usize,
+    pub base_window: usize,
+}
+
+impl Default for AdaptationSettings {
+    fn default() -> Self {
+        Self {
+            step_size: DualAveragingSettings::default(),
+            adapt_metric: true,
+            init_buffer: 75,
+            term_buffer: 50,
+            base_window: 25,
+        }
+    }
+}
+
+impl AdaptationSettings {
+    pub fn validate(&self) -> Result<(), String> {
+        self.step_size.validate()?;
+        if self.base_window == 0 {
+            return Err("the first metric window must be at least 1 iteration".into());
+        }
+        Ok(())
+    }
+}
+
+/// Stan's warm-up: dual averaging throughout, and the metric (diagonal or dense, whichever the
+/// kernel has) re-estimated at the end of each window of [`WarmupSchedule::stan`] from that
+/// window's draws, regularised as Stan does: (n/(n+5))·Σ̂ + 10⁻³·(5/(n+5))·I. After each update
+/// the kernel searches a new initial step size and dual averaging restarts from it.
+///
+/// The metric starts from whatever the kernel has (the identity, or e.g.
+/// [`Metric::from_precision`] of the MAP Hessian); the windows replace it.
+#[derive(Clone, Debug)]
+pub struct WindowedAdaptation {
+    settings: AdaptationSettings,
+    step: StepSizeAdaptation,
+    schedule: Option<WarmupSchedule>,
+    estimator: Option<CovarianceEstimator>,
+}
+
+impl WindowedAdaptation {
+    pub fn new(settings: AdaptationSettings) -> Result<Self, String> {
+        settings.validate()?;
+        Ok(Self {
+            step: StepSizeAdaptation::new(settings.step_size.clone())?,
+            settings,
+            schedule: None,
+            estimator: None,
+        })
+    }
+}
+
+impl Default for WindowedAdaptation {
+    fn default() -> Self {
+        Self::new(AdaptationSettings::default()).expect("the defaults are valid")
+    }
+}
+
+impl<K: HamiltonianKernel> Adaptation<K> for WindowedAdaptation {
+    fn observe(
+        &mut self,
+        kernel: &mut K,
+        state: &State,
+        info: &Info,
+        iteration: usize,
+        n_warmup: usize,
+    ) {
+        self.step.observe_step(kernel, info);
+        if !self.settings.adapt_metric {
+            return;
+        }
+        let s = &self.settings;
+        let schedule = self.schedule.get_or_insert_with(|| {
+            WarmupSchedule::stan(n_warmup, s.init_buffer, s.term_buffer, s.base_window)
+        });
+        if schedule.collects(iteration) {
+            let metric = kernel.metric();
+            self.estimator
+                .get_or_insert_with(|| CovarianceEstimator::new(metric.dim(), metric.kind()))
+                .add(&state.x);
+        }
+        if schedule.ends_window(iteration) {
+            if let Some(estimator) = &mut self.estimator {
+                // A failed estimate (non-finite draws) keeps the previous metric rather than
+                // stopping warm-up: the next window gets another chance.
+                if let Ok(metric) = estimator.regularised_metric() {
+                    *kernel.metric_mut() = metric;
+                }
+                estimator.reset();
+            }
+            *kernel.search_pending_mut() = true;
+            self.step.restart();
+        }
+    }
+
+    fn finish(&mut self, kernel: &mut K) {
+        self.step.finish_step(kernel);
+    }
+}
+
+/// Welford's running mean and (co)variance of a window's draws.
+#[derive(Clone, Debug)]
+struct CovarianceEstimator {
+    kind: MetricKind,
+    n: usize,
+    mean: Vec<f64>,
+    delta: Vec<f64>,
+    /// Σ (x − x̄_new)(x − x̄_old)ᵀ: the diagonal, or the whole matrix column-major.
+    m2: Vec<f64>,
+}
+
+impl CovarianceEstimator {
+    fn new(dim: usize, kind: MetricKind) -> Self {
+        let m2_len = match kind {
+            MetricKind::Diagonal => dim,
+            MetricKind::Dense => dim * dim,
+        };
+        Self {
+            kind,
+            n: 0,
+            mean: vec![0.0; dim],
+            delta: vec![0.0; dim],
+            m2: vec![0.0; m2_len],
+        }
+    }
+
+    fn reset(&mut self) {
+        self.n = 0;
+        self.mean.fill(0.0);
+        self.m2.fill(0.0);
+    }
+
+    fn add(&mut self, x: &[f64]) {
+        self.n += 1;
+        let n = self.n as f64;
+        for ((d, m), x) in self.delta.iter_mut().zip(self.mean.iter_mut()).zip(x) {
+            *d = x - *m;
+            *m += *d / n;
+        }
+        let d = x.len();
+        match self.kind {
+            MetricKind::Diagonal => {
+                for i in 0..d {
+                    self.m2[i] += (x[i] - self.mean[i]) * self.delta[i];
+                }
+            }
+            MetricKind::Dense => {
+                for j in 0..d {
+                    for i in 0..d {
+                        self.m2[i + j * d] += (x[i] - self.mean[i]) * self.delta[j];
+                    }
+                }
+            }
+        }
+    }
+
+    fn regularised_metric(&self) -> Result<Metric, String> {
+        if self.n < 2 {
+            return Err("a window needs at least two draws".into());
+        }
+        let n = self.n as f64;
+        let weight = n / ((n + 5.0) * (n - 1.0));
+        let ridge = 1e-3 * 5.0 / (n + 5.0);
+        let d = self.mean.len();
+        match self.kind {
+            MetricKind::Diagonal => {
+                Metric::diagonal(self.m2.iter().map(|m| weight * m + ridge).collect())
+            }
+            MetricKind::Dense => {
+                // Welford's sum is symmetric up to rounding, which `Metric::dense` evens out.
+                let m2 = DMatrix::from_column_slice(d, d, &self.m2);
+                Metric::dense(m2 * weight + DMatrix::identity(d, d) * ridge)
+            }
+        }
+    }
+}
