@@ -15,9 +15,16 @@ use crate::density::{DensityError, LogDensity};
 use crate::diagnostics::{ParameterSummary, summarize};
 use crate::io::{CmdStanWriter, SamplerColumns};
 use crate::optimize::{MapEstimate, MapSettings, find_map};
+use crate::sampler::NoAdaptation;
+use crate::sampler::adapt::{AdaptationState, HamiltonianKernel, WindowedAdaptation};
 use crate::sampler::adaptive_metropolis::{AdaptiveMetropolis, HaarioAdaptation};
 use crate::sampler::driver::chain_rng;
+use crate::sampler::fisher_mala::{FisherMala, FisherMalaAdaptation};
+use crate::sampler::hmc::{Hmc, HmcSettings};
+use crate::sampler::mala::{Mala, MalaAdaptation, Preconditioner};
+use crate::sampler::metric::{Metric, MetricKind};
 use crate::sampler::metropolis::{Metropolis, PyMc3Tuning};
+use crate::sampler::nuts::{Nuts, NutsSettings};
 use crate::sampler::{Adaptation, ChainOutput, ChainSettings, Kernel, run_chains};
 
 use super::AppError;
@@ -30,6 +37,18 @@ pub enum SamplerKind {
     Metropolis,
     /// Adaptive Metropolis (Haario et al. 2001): joint proposal from the warm-up covariance.
     AdaptiveMetropolis,
+    /// Preconditioned MALA; the preconditioner starts at the inverse MAP Hessian.
+    Mala,
+    /// Static HMC, diagonal metric adapted as in Stan.
+    HmcDiag,
+    /// Static HMC, dense metric started at the inverse MAP Hessian and adapted as in Stan.
+    HmcDense,
+    /// NUTS, diagonal metric adapted as in Stan.
+    NutsDiag,
+    /// NUTS, dense metric started at the inverse MAP Hessian and adapted as in Stan.
+    NutsDense,
+    /// Simplified manifold MALA with the Gauss–Newton (Fisher) metric.
+    FisherMala,
 }
 
 impl SamplerKind {
@@ -37,8 +56,32 @@ impl SamplerKind {
         match self {
             SamplerKind::Metropolis => "metropolis",
             SamplerKind::AdaptiveMetropolis => "adaptive-metropolis",
+            SamplerKind::Mala => "mala",
+            SamplerKind::HmcDiag => "hmc-diag",
+            SamplerKind::HmcDense => "hmc-dense",
+            SamplerKind::NutsDiag => "nuts-diag",
+            SamplerKind::NutsDense => "nuts-dense",
+            SamplerKind::FisherMala => "fisher-mala",
         }
     }
+
+    pub fn uses_gradient(&self) -> bool {
+        !matches!(
+            self,
+            SamplerKind::Metropolis | SamplerKind::AdaptiveMetropolis
+        )
+    }
+
+    pub const ALL: [SamplerKind; 8] = [
+        SamplerKind::Metropolis,
+        SamplerKind::AdaptiveMetropolis,
+        SamplerKind::Mala,
+        SamplerKind::HmcDiag,
+        SamplerKind::HmcDense,
+        SamplerKind::NutsDiag,
+        SamplerKind::NutsDense,
+        SamplerKind::FisherMala,
+    ];
 }
 
 /// How to run a sampler.
@@ -54,6 +97,10 @@ pub struct RunSettings {
     /// deviations inflated by this factor, so that R-hat can detect chains that do not mix.
     pub init_dispersion: f64,
     pub quiet: bool,
+    /// HMC/NUTS: write the adapted step size and metric (of chain 1) here.
+    pub save_adaptation: Option<PathBuf>,
+    /// HMC/NUTS: start every chain from this adaptation and skip adapting.
+    pub load_adaptation: Option<PathBuf>,
 }
 
 impl Default for RunSettings {
@@ -66,6 +113,8 @@ impl Default for RunSettings {
             threads: None,
             init_dispersion: 3.0,
             quiet: false,
+            save_adaptation: None,
+            load_adaptation: None,
         }
     }
 }
@@ -188,7 +237,7 @@ pub fn execute<K, A, F>(
     settings: &RunSettings,
     label: &str,
     make: F,
-) -> Result<Vec<ChainOutput>, AppError>
+) -> Result<Vec<(ChainOutput, K)>, AppError>
 where
     K: Kernel<Counted<CalibrationPosterior>> + Send,
     A: Adaptation<K>,
@@ -215,7 +264,7 @@ where
             .install(work),
         None => work(),
     };
-    Ok(result?.into_iter().map(|(output, _)| output).collect())
+    Ok(result?)
 }
 
 /// Diagnostics of every reported quantity over all chains.
@@ -298,18 +347,144 @@ fn dispatch(
     settings: &RunSettings,
     label: &str,
 ) -> Result<Vec<ChainOutput>, AppError> {
+    let fatal = DensityError::fatal;
     match settings.sampler {
-        SamplerKind::Metropolis => execute(posterior, inits, settings, label, |_| {
+        SamplerKind::Metropolis => Ok(outputs(execute(posterior, inits, settings, label, |_| {
             Ok((Metropolis::for_density(posterior), PyMc3Tuning::new()))
-        }),
-        SamplerKind::AdaptiveMetropolis => execute(posterior, inits, settings, label, |_| {
-            // Started from the Laplace covariance: the posterior's scales span ten orders of
-            // magnitude, which an isotropic start would spend the warm-up discovering.
-            let kernel =
-                AdaptiveMetropolis::from_precision(&map.hessian).map_err(DensityError::fatal)?;
-            Ok((kernel, HaarioAdaptation::default()))
-        }),
+        })?)),
+        SamplerKind::AdaptiveMetropolis => {
+            Ok(outputs(execute(posterior, inits, settings, label, |_| {
+                // Started from the Laplace covariance: the posterior's scales span ten orders of
+                // magnitude, which an isotropic start would spend the warm-up discovering.
+                let kernel = AdaptiveMetropolis::from_precision(&map.hessian).map_err(fatal)?;
+                Ok((kernel, HaarioAdaptation::default()))
+            })?))
+        }
+        SamplerKind::Mala => Ok(outputs(execute(posterior, inits, settings, label, |_| {
+            let preconditioner = Preconditioner::from_hessian(&map.hessian).map_err(fatal)?;
+            // With the Laplace covariance as preconditioner the target is nearly whitened, where
+            // MALA's optimal step is about 1.65·d^(−1/3).
+            let step = 1.65 * (map.x.len() as f64).powf(-1.0 / 3.0);
+            Ok((
+                Mala::new(preconditioner, step).map_err(fatal)?,
+                MalaAdaptation::step_size_only(),
+            ))
+        })?)),
+        SamplerKind::FisherMala => Ok(outputs(execute(posterior, inits, settings, label, |_| {
+            let step = 1.65 * (map.x.len() as f64).powf(-1.0 / 3.0);
+            Ok((
+                FisherMala::new(step).map_err(fatal)?,
+                FisherMalaAdaptation::default(),
+            ))
+        })?)),
+        SamplerKind::HmcDiag | SamplerKind::HmcDense => {
+            let kind = if settings.sampler == SamplerKind::HmcDense {
+                MetricKind::Dense
+            } else {
+                MetricKind::Diagonal
+            };
+            let loaded = load_adaptation(settings)?;
+            let runs = execute(posterior, inits, settings, label, |_| {
+                let kernel = match &loaded {
+                    Some(state) => Hmc::from_adaptation(state, HmcSettings::default()),
+                    None => Hmc::new(warm_metric(map, kind)?, HmcSettings::default()),
+                }
+                .map_err(fatal)?;
+                Ok((kernel, hamiltonian_adaptation(loaded.is_some())))
+            })?;
+            save_adaptation(settings, runs.first().map(|(_, k)| AdaptationState::of(k)))?;
+            Ok(outputs(runs))
+        }
+        SamplerKind::NutsDiag | SamplerKind::NutsDense => {
+            let kind = if settings.sampler == SamplerKind::NutsDense {
+                MetricKind::Dense
+            } else {
+                MetricKind::Diagonal
+            };
+            let loaded = load_adaptation(settings)?;
+            let runs = execute(posterior, inits, settings, label, |_| {
+                let kernel = match &loaded {
+                    Some(state) => Nuts::from_adaptation(state, NutsSettings::default()),
+                    None => Nuts::new(warm_metric(map, kind)?, NutsSettings::default()),
+                }
+                .map_err(fatal)?;
+                Ok((kernel, hamiltonian_adaptation(loaded.is_some())))
+            })?;
+            save_adaptation(settings, runs.first().map(|(_, k)| AdaptationState::of(k)))?;
+            Ok(outputs(runs))
+        }
     }
+}
+
+fn outputs<K>(runs: Vec<(ChainOutput, K)>) -> Vec<ChainOutput> {
+    runs.into_iter().map(|(o, _)| o).collect()
+}
+
+/// The metric a Hamiltonian sampler starts from: the Laplace covariance (dense) or its
+/// diagonal. Stan's windows then refine it on the actual posterior.
+fn warm_metric(map: &MapEstimate, kind: MetricKind) -> Result<Metric, DensityError> {
+    Metric::from_precision(&map.hessian, kind).map_err(DensityError::fatal)
+}
+
+/// Stan's windowed adaptation, or none for a reloaded one.
+fn hamiltonian_adaptation(loaded: bool) -> HamiltonianAdaptation {
+    if loaded {
+        HamiltonianAdaptation::Fixed(NoAdaptation)
+    } else {
+        HamiltonianAdaptation::Windowed(Box::default())
+    }
+}
+
+/// Stan's adaptation or none, chosen at run time.
+enum HamiltonianAdaptation {
+    Fixed(NoAdaptation),
+    Windowed(Box<WindowedAdaptation>),
+}
+
+impl<K: HamiltonianKernel> Adaptation<K> for HamiltonianAdaptation {
+    fn observe(
+        &mut self,
+        kernel: &mut K,
+        state: &crate::sampler::State,
+        info: &crate::sampler::Info,
+        i: usize,
+        n: usize,
+    ) {
+        match self {
+            HamiltonianAdaptation::Fixed(a) => {
+                Adaptation::<K>::observe(a, kernel, state, info, i, n)
+            }
+            HamiltonianAdaptation::Windowed(a) => a.observe(kernel, state, info, i, n),
+        }
+    }
+    fn finish(&mut self, kernel: &mut K) {
+        match self {
+            HamiltonianAdaptation::Fixed(a) => Adaptation::<K>::finish(a, kernel),
+            HamiltonianAdaptation::Windowed(a) => a.finish(kernel),
+        }
+    }
+}
+
+fn load_adaptation(settings: &RunSettings) -> Result<Option<AdaptationState>, AppError> {
+    let Some(path) = &settings.load_adaptation else {
+        return Ok(None);
+    };
+    let text = std::fs::read_to_string(path).map_err(|e| {
+        AppError::Input(crate::io::InputError::new(
+            path,
+            format!("cannot read: {e}"),
+        ))
+    })?;
+    AdaptationState::from_toml(&text)
+        .map(Some)
+        .map_err(|e| AppError::Input(crate::io::InputError::new(path, e)))
+}
+
+fn save_adaptation(settings: &RunSettings, state: Option<AdaptationState>) -> Result<(), AppError> {
+    if let (Some(path), Some(state)) = (&settings.save_adaptation, state) {
+        crate::io::write_atomically(path, state.to_toml().as_bytes())?;
+    }
+    Ok(())
 }
 
 /// Writes each chain's draws in CmdStan's CSV layout with the run's provenance.

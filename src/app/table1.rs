@@ -128,6 +128,17 @@ pub fn protocol(sampler: SamplerKind, bm2: bool, quick: bool) -> ChainSettings {
                 keep: Some(4_000),
             },
         },
+        // Gradient samplers: Stan's default lengths.
+        _ if quick => ChainSettings {
+            warmup: 500,
+            draws: 500,
+            keep: None,
+        },
+        _ => ChainSettings {
+            warmup: 1000,
+            draws: 1000,
+            keep: None,
+        },
     }
 }
 

@@ -411,7 +411,7 @@ impl<K: HamiltonianKernel> Adaptation<K> for WindowedAdaptation {
             if let Some(estimator) = &mut self.estimator {
                 // A failed estimate (non-finite draws) keeps the previous metric rather than
                 // stopping warm-up: the next window gets another chance.
-                if let Ok(metric) = estimator.regularised_metric() {
+                if let Ok(metric) = estimator.regularised_metric(kernel.metric()) {
                     *kernel.metric_mut() = metric;
                 }
                 estimator.reset();
@@ -482,22 +482,32 @@ impl CovarianceEstimator {
         }
     }
 
-    fn regularised_metric(&self) -> Result<Metric, String> {
+    /// Stan's shrinkage, n/(n+5)·Σ̂ + 5/(n+5)·(prior), with the prior the metric in use
+    /// rather than Stan's 1e-3·I: Stan's ridge assumes unit scales, and on the motor
+    /// posterior (Var R ≈ 1e-8) it would inflate R's variance a thousandfold and force a step
+    /// size thirty times too small. Shrinking toward the current metric is scale-free, and a
+    /// short window (fewer draws than dimensions) cannot make a good warm start singular.
+    fn regularised_metric(&self, current: &Metric) -> Result<Metric, String> {
         if self.n < 2 {
             return Err("a window needs at least two draws".into());
         }
         let n = self.n as f64;
         let weight = n / ((n + 5.0) * (n - 1.0));
-        let ridge = 1e-3 * 5.0 / (n + 5.0);
+        let prior_weight = 5.0 / (n + 5.0);
         let d = self.mean.len();
+        let prior = current.inverse_mass_matrix();
         match self.kind {
-            MetricKind::Diagonal => {
-                Metric::diagonal(self.m2.iter().map(|m| weight * m + ridge).collect())
-            }
+            MetricKind::Diagonal => Metric::diagonal(
+                self.m2
+                    .iter()
+                    .enumerate()
+                    .map(|(i, m)| weight * m + prior_weight * prior[(i, i)])
+                    .collect(),
+            ),
             MetricKind::Dense => {
                 // Welford's sum is symmetric up to rounding, which `Metric::dense` evens out.
                 let m2 = DMatrix::from_column_slice(d, d, &self.m2);
-                Metric::dense(m2 * weight + DMatrix::identity(d, d) * ridge)
+                Metric::dense(m2 * weight + prior * prior_weight)
             }
         }
     }

@@ -8,12 +8,12 @@
 pub mod adapt;
 pub mod adaptive_metropolis;
 pub mod driver;
-pub mod hmc;
-pub mod metric;
-pub mod nuts;
-pub mod metropolis;
 pub mod fisher_mala;
+pub mod hmc;
 pub mod mala;
+pub mod metric;
+pub mod metropolis;
+pub mod nuts;
 pub mod targets;
 
 pub use driver::{ChainOutput, ChainSettings, DrawRecord, run_chain, run_chains};
