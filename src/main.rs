@@ -130,7 +130,7 @@ enum PriorFamily {
 /// Options shared by every command that samples.
 #[derive(clap::Args, Clone)]
 struct RunArgs {
-    #[arg(long, value_enum, default_value_t = app::run::SamplerKind::AdaptiveMetropolis)]
+    #[arg(long, value_enum, default_value_t = app::run::SamplerKind::NutsDense)]
     sampler: app::run::SamplerKind,
     #[arg(long, default_value_t = 4)]
     chains: usize,
@@ -149,6 +149,12 @@ struct RunArgs {
     /// No progress bars.
     #[arg(long)]
     quiet: bool,
+    /// HMC/NUTS: save the adapted step size and metric (TOML) for a later warm start.
+    #[arg(long)]
+    save_adaptation: Option<PathBuf>,
+    /// HMC/NUTS: start from a saved adaptation and skip adapting (use with a short --warmup).
+    #[arg(long)]
+    load_adaptation: Option<PathBuf>,
 }
 
 impl RunArgs {
@@ -164,6 +170,8 @@ impl RunArgs {
             seed: self.seed,
             threads: self.threads,
             quiet: self.quiet,
+            save_adaptation: self.save_adaptation.clone(),
+            load_adaptation: self.load_adaptation.clone(),
             ..app::run::RunSettings::default()
         }
     }
