@@ -45,6 +45,8 @@ enum Command {
     },
     /// Calibrate a model file on a recording with BM1 or BM2(K): MAP, then MCMC.
     Fit(FitArgs),
+    /// Effective samples per second of every sampler across K, side by side.
+    Bench(BenchArgs),
     /// Reproduce a result of the paper.
     Reproduce {
         #[command(subcommand)]
@@ -208,6 +210,62 @@ fn fit(args: FitArgs) -> Result<(), AppError> {
     Ok(())
 }
 
+#[derive(clap::Args)]
+struct BenchArgs {
+    /// Discrepancy degrees, comma separated.
+    #[arg(long, value_delimiter = ',', default_values_t = motorcal::app::bench::DEFAULT_KS)]
+    k: Vec<usize>,
+    /// Samplers, comma separated (default: all).
+    #[arg(long, value_enum, value_delimiter = ',')]
+    samplers: Vec<app::run::SamplerKind>,
+    /// Thread counts, comma separated (default: 1 and all cores).
+    #[arg(long, value_delimiter = ',')]
+    threads: Vec<usize>,
+    #[arg(long, default_value_t = 4)]
+    chains: usize,
+    /// Draws per chain (default: per sampler, extended until converged).
+    #[arg(long)]
+    draws: Option<usize>,
+    #[arg(long)]
+    warmup: Option<usize>,
+    #[arg(long, default_value_t = motorcal::synthetic::DEFAULT_SEED)]
+    seed: u64,
+    /// A recording to bench on instead of the paper's data (with --model).
+    #[arg(long)]
+    data: Option<PathBuf>,
+    #[arg(long)]
+    model: Option<PathBuf>,
+    #[arg(long, default_value = "out/bench")]
+    out: PathBuf,
+    /// Write the records as JSON here (default: OUT/bench.json).
+    #[arg(long)]
+    json: Option<PathBuf>,
+    #[arg(long)]
+    quiet: bool,
+}
+
+fn bench(args: BenchArgs) -> Result<(), AppError> {
+    let defaults = app::bench::BenchOptions::default();
+    let options = app::bench::BenchOptions {
+        ks: args.k,
+        samplers: if args.samplers.is_empty() { defaults.samplers } else { args.samplers },
+        threads: if args.threads.is_empty() { defaults.threads } else { args.threads },
+        chains: args.chains,
+        draws: args.draws,
+        warmup: args.warmup,
+        seed: args.seed,
+        data: args.data,
+        model: args.model,
+        out: args.out,
+        json: args.json,
+        quiet: args.quiet,
+    };
+    let records = app::bench::bench(&options)?;
+    print!("{}", app::bench::format_table(&records));
+    println!("wrote {}/bench.csv, bench.json and ess_per_*.png", options.out.display());
+    Ok(())
+}
+
 fn table1(args: Table1Args) -> Result<(), AppError> {
     let options = app::table1::Table1Options {
         seed: args.seed,
@@ -249,6 +307,7 @@ fn run(cli: Cli) -> Result<(), AppError> {
             what: Reproduce::Table1(args),
         }) => table1(args),
         Some(Command::Fit(args)) => fit(args),
+        Some(Command::Bench(args)) => bench(args),
         Some(Command::Simulate {
             truth,
             nominal,

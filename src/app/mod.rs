@@ -1,6 +1,7 @@
 //! The commands behind the binary: each turns options into library calls and reports. Kept in
 //! the library so that tests drive them exactly as a user does.
 
+pub mod bench;
 pub mod fit;
 pub mod predictive;
 pub mod problem;

@@ -1,0 +1,304 @@
+//! `motorcal bench`: effective samples per second of every sampler across K, measured side by
+//! side on the same data and seeds.
+
+use std::path::PathBuf;
+
+use serde::Serialize;
+
+use crate::bayes::ModelSettings;
+use crate::plot::{self, SamplerCurve};
+use crate::sampler::ChainSettings;
+use crate::synthetic::DEFAULT_SEED;
+
+use super::problem::Problem;
+use super::run::{RunOutput, RunSettings, SamplerKind, run_sampler};
+use super::AppError;
+
+/// The K values of the study unless told otherwise.
+pub const DEFAULT_KS: [usize; 7] = [0, 3, 6, 9, 12, 15, 20];
+/// The paper ran 100000 draws per chain; an unconverged baseline is extended up to this.
+pub const MAX_BASELINE_DRAWS: usize = 100_000;
+/// Gradient samplers are extended up to this many draws when they have not converged.
+pub const MAX_GRADIENT_DRAWS: usize = 16_000;
+
+#[derive(Clone, Debug, Serialize)]
+pub struct BenchOptions {
+    pub ks: Vec<usize>,
+    pub samplers: Vec<SamplerKind>,
+    /// Thread counts to measure at (1 is the per-core figure).
+    pub threads: Vec<usize>,
+    pub chains: usize,
+    /// Draws per chain of the first attempt (default per sampler when `None`).
+    pub draws: Option<usize>,
+    pub warmup: Option<usize>,
+    pub seed: u64,
+    pub data: Option<PathBuf>,
+    pub model: Option<PathBuf>,
+    pub out: PathBuf,
+    pub json: Option<PathBuf>,
+    pub quiet: bool,
+}
+
+impl Default for BenchOptions {
+    fn default() -> Self {
+        Self {
+            ks: DEFAULT_KS.to_vec(),
+            samplers: SamplerKind::ALL.to_vec(),
+            threads: vec![1, std::thread::available_parallelism().map_or(1, |n| n.get())],
+            chains: 4,
+            draws: None,
+            warmup: None,
+            seed: DEFAULT_SEED,
+            data: None,
+            model: None,
+            out: PathBuf::from("out/bench"),
+            json: None,
+            quiet: false,
+        }
+    }
+}
+
+/// One (sampler, K, threads) measurement: the stable contract of `--json`.
+#[derive(Clone, Debug, Serialize)]
+pub struct BenchRecord {
+    pub sampler: String,
+    pub k: usize,
+    pub threads: usize,
+    pub chains: usize,
+    pub warmup: usize,
+    pub draws: usize,
+    pub min_ess_bulk: f64,
+    /// min bulk-ESS over all parameters per second of the sampling phase (warm-up excluded).
+    pub min_ess_per_s: f64,
+    /// min bulk-ESS per gradient evaluation (gradient samplers) or per density evaluation.
+    pub min_ess_per_eval: f64,
+    pub eval_kind: String,
+    pub evaluations: u64,
+    pub max_rhat: f64,
+    /// R-hat ≤ 1.01 and min bulk-ESS ≥ 100.
+    pub converged: bool,
+    /// The run did not converge even at the longest length tried: its ESS is not to be
+    /// trusted (it overstates the sampler), so ratios against it are lower bounds.
+    pub lower_bound: bool,
+    pub wall_s: f64,
+    pub warmup_s: f64,
+    /// Sampling time summed over chains (CPU seconds of the sampling phase).
+    pub sampling_cpu_s: f64,
+    pub divergences: usize,
+}
+
+fn first_attempt(sampler: SamplerKind, options: &BenchOptions) -> ChainSettings {
+    let (warmup, draws) = match sampler {
+        SamplerKind::Metropolis => (500, 5000),
+        SamplerKind::AdaptiveMetropolis => (5000, 5000),
+        _ => (1000, 1000),
+    };
+    ChainSettings { warmup: options.warmup.unwrap_or(warmup), draws: options.draws.unwrap_or(draws), keep: None }
+}
+
+fn converged(run: &RunOutput) -> bool {
+    run.max_rhat <= 1.01 && run.min_ess_bulk >= 100.0
+}
+
+/// Runs a sampler, four times longer each time it has not converged, up to its cap.
+fn run_until_converged(
+    posterior: &mut crate::bayes::CalibrationPosterior,
+    sampler: SamplerKind,
+    threads: usize,
+    options: &BenchOptions,
+    label: &str,
+) -> Result<(RunOutput, ChainSettings), AppError> {
+    let cap = if sampler.uses_gradient() { MAX_GRADIENT_DRAWS } else { MAX_BASELINE_DRAWS };
+    let mut chain = first_attempt(sampler, options);
+    loop {
+        let settings = RunSettings {
+            sampler,
+            chains: options.chains,
+            chain: chain.clone(),
+            seed: options.seed,
+            threads: Some(threads),
+            quiet: options.quiet,
+            ..RunSettings::default()
+        };
+        let run = run_sampler(posterior, &settings, label)?;
+        if converged(&run) || chain.draws >= cap || options.draws.is_some() {
+            return Ok((run, chain));
+        }
+        chain.draws = (chain.draws * 4).min(cap);
+    }
+}
+
+fn record(sampler: SamplerKind, k: usize, threads: usize, chains: usize, chain: &ChainSettings, run: &RunOutput) -> BenchRecord {
+    let sampling_cpu_s: f64 = run.chains.iter().map(|c| c.sampling_seconds).sum();
+    // Chains run min(threads, chains) at a time, so the sampling phase's wall time is its
+    // CPU time shared among them.
+    let sampling_wall = sampling_cpu_s / threads.min(chains).max(1) as f64;
+    let (evaluations, eval_kind) = if sampler.uses_gradient() {
+        (run.sampling_gradient_evaluations, "gradient")
+    } else {
+        (run.sampling_density_evaluations, "density")
+    };
+    let ok = converged(run);
+    BenchRecord {
+        sampler: sampler.name().into(),
+        k,
+        threads,
+        chains,
+        warmup: chain.warmup,
+        draws: chain.draws,
+        min_ess_bulk: run.min_ess_bulk,
+        min_ess_per_s: run.min_ess_bulk / sampling_wall,
+        min_ess_per_eval: run.min_ess_bulk / evaluations.max(1) as f64,
+        eval_kind: eval_kind.into(),
+        evaluations,
+        max_rhat: run.max_rhat,
+        converged: ok,
+        lower_bound: !ok,
+        wall_s: run.wall_seconds,
+        warmup_s: run.warmup_seconds,
+        sampling_cpu_s,
+        divergences: run.divergences,
+    }
+}
+
+pub fn bench(options: &BenchOptions) -> Result<Vec<BenchRecord>, AppError> {
+    if options.ks.is_empty() || options.samplers.is_empty() || options.threads.is_empty() {
+        return Err(AppError::Usage("bench: name at least one K, sampler and thread count".into()));
+    }
+    if let Some(&k) = options.ks.iter().find(|&&k| k > crate::bayes::basis::MAX_LEGENDRE_DEGREE) {
+        return Err(AppError::Usage(format!("--k {k}: the discrepancy degree must be at most {}", crate::bayes::basis::MAX_LEGENDRE_DEGREE)));
+    }
+    if options.threads.contains(&0) || options.chains == 0 {
+        return Err(AppError::Usage("--threads and --chains must be at least 1".into()));
+    }
+    let problem = match (&options.data, &options.model) {
+        (Some(d), Some(m)) => Problem::from_files(d, m)?,
+        (None, None) => Problem::paper(options.seed)?,
+        _ => return Err(AppError::Usage("--data and --model go together".into())),
+    };
+    let mut records = Vec::new();
+    for &k in &options.ks {
+        let mut posterior = problem.posterior(&ModelSettings::bm2(k))?;
+        for &sampler in &options.samplers {
+            for &threads in &options.threads {
+                let label = format!("K={k} t={threads}");
+                let (run, chain) = run_until_converged(&mut posterior, sampler, threads, options, &label)?;
+                let r = record(sampler, k, threads, options.chains, &chain, &run);
+                if !options.quiet {
+                    eprintln!("{}", format_record(&r));
+                }
+                records.push(r);
+            }
+        }
+    }
+    write_outputs(options, &records)?;
+    Ok(records)
+}
+
+fn format_record(r: &BenchRecord) -> String {
+    format!(
+        "{:<20} K={:<3} t={:<2} draws {:>6}  min ESS {:>8.0}  ESS/s {:>10.2}  ESS/{} {:>9.5}  R-hat {:>6.3}  wall {:>7.1} s{}",
+        r.sampler,
+        r.k,
+        r.threads,
+        r.draws,
+        r.min_ess_bulk,
+        r.min_ess_per_s,
+        r.eval_kind,
+        r.min_ess_per_eval,
+        r.max_rhat,
+        r.wall_s,
+        if r.converged { "" } else { "  NOT CONVERGED (bound)" }
+    )
+}
+
+/// The table, and the ratio of the best gradient sampler to each baseline per K.
+pub fn format_table(records: &[BenchRecord]) -> String {
+    let mut out = String::new();
+    out.push_str(&format!(
+        "{:<20} {:>3} {:>3} {:>7} {:>9} {:>11} {:>11} {:>9} {:>7} {:>8} {:>8}\n",
+        "sampler", "K", "thr", "draws", "min ESS", "ESS/s", "ESS/eval", "eval", "R-hat", "wall s", "conv"
+    ));
+    for r in records {
+        out.push_str(&format!(
+            "{:<20} {:>3} {:>3} {:>7} {:>9.0} {:>11.2} {:>11.5} {:>9} {:>7.3} {:>8.1} {:>8}\n",
+            r.sampler, r.k, r.threads, r.draws, r.min_ess_bulk, r.min_ess_per_s, r.min_ess_per_eval, r.eval_kind, r.max_rhat, r.wall_s,
+            if r.converged { "yes" } else { "no" }
+        ));
+    }
+    let mut keys: Vec<(usize, usize)> = records.iter().map(|r| (r.k, r.threads)).collect();
+    keys.dedup();
+    keys.sort();
+    keys.dedup();
+    out.push('\n');
+    for (k, threads) in keys {
+        let here: Vec<&BenchRecord> = records.iter().filter(|r| r.k == k && r.threads == threads).collect();
+        let best = here
+            .iter()
+            .filter(|r| r.eval_kind == "gradient" && r.converged)
+            .max_by(|a, b| a.min_ess_per_s.total_cmp(&b.min_ess_per_s));
+        let Some(best) = best else { continue };
+        for base in here.iter().filter(|r| r.eval_kind == "density") {
+            let ratio = best.min_ess_per_s / base.min_ess_per_s;
+            out.push_str(&format!(
+                "K={k:<3} threads={threads}: {} / {} = {}{:.1}×{}\n",
+                best.sampler,
+                base.sampler,
+                if base.lower_bound { "≥ " } else { "" },
+                ratio,
+                if base.lower_bound { " (baseline not converged at its longest run)" } else { "" }
+            ));
+        }
+    }
+    out
+}
+
+fn write_outputs(options: &BenchOptions, records: &[BenchRecord]) -> Result<(), AppError> {
+    let json = serde_json::to_string_pretty(records).map_err(|e| AppError::Output(e.to_string()))?;
+    let json_path = options.json.clone().unwrap_or_else(|| options.out.join("bench.json"));
+    crate::io::write_atomically(&json_path, json.as_bytes())?;
+    let mut csv = String::from(
+        "sampler,k,threads,chains,warmup,draws,min_ess_bulk,min_ess_per_s,min_ess_per_eval,eval_kind,evaluations,max_rhat,converged,lower_bound,wall_s,warmup_s,sampling_cpu_s,divergences\n",
+    );
+    for r in records {
+        csv.push_str(&format!(
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+            r.sampler, r.k, r.threads, r.chains, r.warmup, r.draws, r.min_ess_bulk, r.min_ess_per_s, r.min_ess_per_eval, r.eval_kind,
+            r.evaluations, r.max_rhat, r.converged, r.lower_bound, r.wall_s, r.warmup_s, r.sampling_cpu_s, r.divergences
+        ));
+    }
+    crate::io::write_atomically(&options.out.join("bench.csv"), csv.as_bytes())?;
+    for threads in options.threads.iter().copied() {
+        let curves = |value: fn(&BenchRecord) -> f64| -> Vec<SamplerCurve> {
+            options
+                .samplers
+                .iter()
+                .map(|s| SamplerCurve {
+                    sampler: s.name().into(),
+                    points: records
+                        .iter()
+                        .filter(|r| r.sampler == s.name() && r.threads == threads)
+                        .map(|r| (r.k as f64, value(r), r.lower_bound))
+                        .collect(),
+                })
+                .filter(|c| !c.points.is_empty())
+                .collect()
+        };
+        let err = |e: plot::PlotError| AppError::Output(e.to_string());
+        plot::ess_per_second(
+            &options.out.join(format!("ess_per_second_t{threads}.png")),
+            &format!("min bulk-ESS per second of sampling, {threads} thread(s), {} chains", options.chains),
+            "min ESS / s",
+            &curves(|r| r.min_ess_per_s),
+        )
+        .map_err(err)?;
+        plot::ess_per_second(
+            &options.out.join(format!("ess_per_eval_t{threads}.png")),
+            &format!("min bulk-ESS per gradient (or density) evaluation, {threads} thread(s)"),
+            "min ESS / evaluation",
+            &curves(|r| r.min_ess_per_eval),
+        )
+        .map_err(err)?;
+    }
+    Ok(())
+}
