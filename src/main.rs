@@ -248,8 +248,16 @@ fn bench(args: BenchArgs) -> Result<(), AppError> {
     let defaults = app::bench::BenchOptions::default();
     let options = app::bench::BenchOptions {
         ks: args.k,
-        samplers: if args.samplers.is_empty() { defaults.samplers } else { args.samplers },
-        threads: if args.threads.is_empty() { defaults.threads } else { args.threads },
+        samplers: if args.samplers.is_empty() {
+            defaults.samplers
+        } else {
+            args.samplers
+        },
+        threads: if args.threads.is_empty() {
+            defaults.threads
+        } else {
+            args.threads
+        },
         chains: args.chains,
         draws: args.draws,
         warmup: args.warmup,
@@ -262,7 +270,10 @@ fn bench(args: BenchArgs) -> Result<(), AppError> {
     };
     let records = app::bench::bench(&options)?;
     print!("{}", app::bench::format_table(&records));
-    println!("wrote {}/bench.csv, bench.json and ess_per_*.png", options.out.display());
+    println!(
+        "wrote {}/bench.csv, bench.json and ess_per_*.png",
+        options.out.display()
+    );
     Ok(())
 }
 

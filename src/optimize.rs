@@ -163,6 +163,8 @@ pub fn find_map<P: FisherMetric>(
             .transpose()
             .try_inverse()
             .ok_or_else(|| DensityError::fatal("singular metric"))?;
+        let origin = x0.clone();
+        let transform = l_inv_t.clone();
         let problem = Whitened {
             density: RefCell::new(&mut *density),
             origin: x0.clone(),
@@ -173,22 +175,18 @@ pub fn find_map<P: FisherMetric>(
             .with_tolerance_grad(settings.gradient_tolerance)
             .and_then(|s| s.with_tolerance_cost(1e-14))
             .map_err(|e| DensityError::fatal(e.to_string()))?;
-        let result = Executor::new(problem, solver)
+        // A line search that gives up is not fatal: the Gauss–Newton polish below continues
+        // from the best point found.
+        if let Ok(result) = Executor::new(problem, solver)
             .configure(|state| state.param(vec![0.0; d]).max_iters(settings.max_iterations))
             .run()
-            .map_err(|e| DensityError::fatal(format!("MAP search failed: {e}")))?;
-        iterations += result.state().get_iter();
-        let z = result
-            .state()
-            .get_best_param()
-            .cloned()
-            .unwrap_or_else(|| vec![0.0; d]);
-        x0 = result
-            .problem
-            .problem
-            .as_ref()
-            .expect("problem is returned")
-            .to_x(&z);
+        {
+            iterations += result.state().get_iter();
+            if let Some(z) = result.state().get_best_param() {
+                let dx = &transform * DVector::from_column_slice(z);
+                x0 = origin.iter().zip(dx.iter()).map(|(a, b)| a + b).collect();
+            }
+        }
     }
     // Gauss–Newton polish: L-BFGS stalls when the cost's change falls below its rounding
     // (the log density is ~10³ at the mode); Newton steps on the gradient do not.

@@ -10,9 +10,9 @@ use crate::plot::{self, SamplerCurve};
 use crate::sampler::ChainSettings;
 use crate::synthetic::DEFAULT_SEED;
 
+use super::AppError;
 use super::problem::Problem;
 use super::run::{RunOutput, RunSettings, SamplerKind, run_sampler};
-use super::AppError;
 
 /// The K values of the study unless told otherwise.
 pub const DEFAULT_KS: [usize; 7] = [0, 3, 6, 9, 12, 15, 20];
@@ -44,7 +44,10 @@ impl Default for BenchOptions {
         Self {
             ks: DEFAULT_KS.to_vec(),
             samplers: SamplerKind::ALL.to_vec(),
-            threads: vec![1, std::thread::available_parallelism().map_or(1, |n| n.get())],
+            threads: vec![
+                1,
+                std::thread::available_parallelism().map_or(1, |n| n.get()),
+            ],
             chains: 4,
             draws: None,
             warmup: None,
@@ -93,7 +96,11 @@ fn first_attempt(sampler: SamplerKind, options: &BenchOptions) -> ChainSettings 
         SamplerKind::AdaptiveMetropolis => (5000, 5000),
         _ => (1000, 1000),
     };
-    ChainSettings { warmup: options.warmup.unwrap_or(warmup), draws: options.draws.unwrap_or(draws), keep: None }
+    ChainSettings {
+        warmup: options.warmup.unwrap_or(warmup),
+        draws: options.draws.unwrap_or(draws),
+        keep: None,
+    }
 }
 
 fn converged(run: &RunOutput) -> bool {
@@ -108,7 +115,11 @@ fn run_until_converged(
     options: &BenchOptions,
     label: &str,
 ) -> Result<(RunOutput, ChainSettings), AppError> {
-    let cap = if sampler.uses_gradient() { MAX_GRADIENT_DRAWS } else { MAX_BASELINE_DRAWS };
+    let cap = if sampler.uses_gradient() {
+        MAX_GRADIENT_DRAWS
+    } else {
+        MAX_BASELINE_DRAWS
+    };
     let mut chain = first_attempt(sampler, options);
     loop {
         let settings = RunSettings {
@@ -128,7 +139,14 @@ fn run_until_converged(
     }
 }
 
-fn record(sampler: SamplerKind, k: usize, threads: usize, chains: usize, chain: &ChainSettings, run: &RunOutput) -> BenchRecord {
+fn record(
+    sampler: SamplerKind,
+    k: usize,
+    threads: usize,
+    chains: usize,
+    chain: &ChainSettings,
+    run: &RunOutput,
+) -> BenchRecord {
     let sampling_cpu_s: f64 = run.chains.iter().map(|c| c.sampling_seconds).sum();
     // Chains run min(threads, chains) at a time, so the sampling phase's wall time is its
     // CPU time shared among them.
@@ -163,13 +181,24 @@ fn record(sampler: SamplerKind, k: usize, threads: usize, chains: usize, chain: 
 
 pub fn bench(options: &BenchOptions) -> Result<Vec<BenchRecord>, AppError> {
     if options.ks.is_empty() || options.samplers.is_empty() || options.threads.is_empty() {
-        return Err(AppError::Usage("bench: name at least one K, sampler and thread count".into()));
+        return Err(AppError::Usage(
+            "bench: name at least one K, sampler and thread count".into(),
+        ));
     }
-    if let Some(&k) = options.ks.iter().find(|&&k| k > crate::bayes::basis::MAX_LEGENDRE_DEGREE) {
-        return Err(AppError::Usage(format!("--k {k}: the discrepancy degree must be at most {}", crate::bayes::basis::MAX_LEGENDRE_DEGREE)));
+    if let Some(&k) = options
+        .ks
+        .iter()
+        .find(|&&k| k > crate::bayes::basis::MAX_LEGENDRE_DEGREE)
+    {
+        return Err(AppError::Usage(format!(
+            "--k {k}: the discrepancy degree must be at most {}",
+            crate::bayes::basis::MAX_LEGENDRE_DEGREE
+        )));
     }
     if options.threads.contains(&0) || options.chains == 0 {
-        return Err(AppError::Usage("--threads and --chains must be at least 1".into()));
+        return Err(AppError::Usage(
+            "--threads and --chains must be at least 1".into(),
+        ));
     }
     let problem = match (&options.data, &options.model) {
         (Some(d), Some(m)) => Problem::from_files(d, m)?,
@@ -182,7 +211,8 @@ pub fn bench(options: &BenchOptions) -> Result<Vec<BenchRecord>, AppError> {
         for &sampler in &options.samplers {
             for &threads in &options.threads {
                 let label = format!("K={k} t={threads}");
-                let (run, chain) = run_until_converged(&mut posterior, sampler, threads, options, &label)?;
+                let (run, chain) =
+                    run_until_converged(&mut posterior, sampler, threads, options, &label)?;
                 let r = record(sampler, k, threads, options.chains, &chain, &run);
                 if !options.quiet {
                     eprintln!("{}", format_record(&r));
@@ -208,7 +238,11 @@ fn format_record(r: &BenchRecord) -> String {
         r.min_ess_per_eval,
         r.max_rhat,
         r.wall_s,
-        if r.converged { "" } else { "  NOT CONVERGED (bound)" }
+        if r.converged {
+            ""
+        } else {
+            "  NOT CONVERGED (bound)"
+        }
     )
 }
 
@@ -217,12 +251,31 @@ pub fn format_table(records: &[BenchRecord]) -> String {
     let mut out = String::new();
     out.push_str(&format!(
         "{:<20} {:>3} {:>3} {:>7} {:>9} {:>11} {:>11} {:>9} {:>7} {:>8} {:>8}\n",
-        "sampler", "K", "thr", "draws", "min ESS", "ESS/s", "ESS/eval", "eval", "R-hat", "wall s", "conv"
+        "sampler",
+        "K",
+        "thr",
+        "draws",
+        "min ESS",
+        "ESS/s",
+        "ESS/eval",
+        "eval",
+        "R-hat",
+        "wall s",
+        "conv"
     ));
     for r in records {
         out.push_str(&format!(
             "{:<20} {:>3} {:>3} {:>7} {:>9.0} {:>11.2} {:>11.5} {:>9} {:>7.3} {:>8.1} {:>8}\n",
-            r.sampler, r.k, r.threads, r.draws, r.min_ess_bulk, r.min_ess_per_s, r.min_ess_per_eval, r.eval_kind, r.max_rhat, r.wall_s,
+            r.sampler,
+            r.k,
+            r.threads,
+            r.draws,
+            r.min_ess_bulk,
+            r.min_ess_per_s,
+            r.min_ess_per_eval,
+            r.eval_kind,
+            r.max_rhat,
+            r.wall_s,
             if r.converged { "yes" } else { "no" }
         ));
     }
@@ -232,7 +285,10 @@ pub fn format_table(records: &[BenchRecord]) -> String {
     keys.dedup();
     out.push('\n');
     for (k, threads) in keys {
-        let here: Vec<&BenchRecord> = records.iter().filter(|r| r.k == k && r.threads == threads).collect();
+        let here: Vec<&BenchRecord> = records
+            .iter()
+            .filter(|r| r.k == k && r.threads == threads)
+            .collect();
         let best = here
             .iter()
             .filter(|r| r.eval_kind == "gradient" && r.converged)
@@ -246,7 +302,11 @@ pub fn format_table(records: &[BenchRecord]) -> String {
                 base.sampler,
                 if base.lower_bound { "≥ " } else { "" },
                 ratio,
-                if base.lower_bound { " (baseline not converged at its longest run)" } else { "" }
+                if base.lower_bound {
+                    " (baseline not converged at its longest run)"
+                } else {
+                    ""
+                }
             ));
         }
     }
@@ -254,8 +314,12 @@ pub fn format_table(records: &[BenchRecord]) -> String {
 }
 
 fn write_outputs(options: &BenchOptions, records: &[BenchRecord]) -> Result<(), AppError> {
-    let json = serde_json::to_string_pretty(records).map_err(|e| AppError::Output(e.to_string()))?;
-    let json_path = options.json.clone().unwrap_or_else(|| options.out.join("bench.json"));
+    let json =
+        serde_json::to_string_pretty(records).map_err(|e| AppError::Output(e.to_string()))?;
+    let json_path = options
+        .json
+        .clone()
+        .unwrap_or_else(|| options.out.join("bench.json"));
     crate::io::write_atomically(&json_path, json.as_bytes())?;
     let mut csv = String::from(
         "sampler,k,threads,chains,warmup,draws,min_ess_bulk,min_ess_per_s,min_ess_per_eval,eval_kind,evaluations,max_rhat,converged,lower_bound,wall_s,warmup_s,sampling_cpu_s,divergences\n",
@@ -263,8 +327,24 @@ fn write_outputs(options: &BenchOptions, records: &[BenchRecord]) -> Result<(), 
     for r in records {
         csv.push_str(&format!(
             "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
-            r.sampler, r.k, r.threads, r.chains, r.warmup, r.draws, r.min_ess_bulk, r.min_ess_per_s, r.min_ess_per_eval, r.eval_kind,
-            r.evaluations, r.max_rhat, r.converged, r.lower_bound, r.wall_s, r.warmup_s, r.sampling_cpu_s, r.divergences
+            r.sampler,
+            r.k,
+            r.threads,
+            r.chains,
+            r.warmup,
+            r.draws,
+            r.min_ess_bulk,
+            r.min_ess_per_s,
+            r.min_ess_per_eval,
+            r.eval_kind,
+            r.evaluations,
+            r.max_rhat,
+            r.converged,
+            r.lower_bound,
+            r.wall_s,
+            r.warmup_s,
+            r.sampling_cpu_s,
+            r.divergences
         ));
     }
     crate::io::write_atomically(&options.out.join("bench.csv"), csv.as_bytes())?;
@@ -287,7 +367,10 @@ fn write_outputs(options: &BenchOptions, records: &[BenchRecord]) -> Result<(), 
         let err = |e: plot::PlotError| AppError::Output(e.to_string());
         plot::ess_per_second(
             &options.out.join(format!("ess_per_second_t{threads}.png")),
-            &format!("min bulk-ESS per second of sampling, {threads} thread(s), {} chains", options.chains),
+            &format!(
+                "min bulk-ESS per second of sampling, {threads} thread(s), {} chains",
+                options.chains
+            ),
             "min ESS / s",
             &curves(|r| r.min_ess_per_s),
         )
