@@ -122,7 +122,9 @@ where
     let mut t = t0;
     let mut segment = breakpoints.partition_point(|&b| b <= t0);
     let mut h: Option<f64> = None;
-    let mut fac_old = 1e-4;
+    // ln of the previous accepted step's error: the controller works in logs, since two
+    // `powf` calls per step cost as much as the right-hand side evaluations.
+    let mut ln_err_old = (1e-4f64).ln();
     let mut steps = 0usize;
 
     while next_out < t_out.len() {
@@ -172,7 +174,8 @@ where
                 last_rejected = true;
                 continue;
             }
-            let fac11 = err.powf(EXPO);
+            let ln_err = err.max(1e-300).ln();
+            let fac11 = (EXPO * ln_err).exp();
             if err <= 1.0 {
                 let t_new = if lands { seg_end } else { t + h_step };
                 if !s.y_new.iter().all(|v| v.re().is_finite()) {
@@ -188,12 +191,12 @@ where
                 std::mem::swap(&mut y, &mut s.y_new);
                 s.k.swap(0, 6); // first same as last
                 t = t_new;
-                let mut fac =
-                    (fac11 / fac_old.powf(BETA) / SAFETY).clamp(1.0 / MAX_GROWTH, MAX_SHRINK);
+                let mut fac = ((EXPO * ln_err - BETA * ln_err_old).exp() / SAFETY)
+                    .clamp(1.0 / MAX_GROWTH, MAX_SHRINK);
                 if last_rejected {
                     fac = fac.max(1.0);
                 }
-                fac_old = err.max(1e-4);
+                ln_err_old = ln_err.max((1e-4f64).ln());
                 // A step clipped to land on a breakpoint says little about the next segment's
                 // scale: keep the larger of the planned and the proposed size.
                 step = if lands {
