@@ -68,7 +68,7 @@ enum Reproduce {
     Table1(Table1Args),
 }
 
-#[derive(clap::Args, Default)]
+#[derive(clap::Args)]
 struct Table1Args {
     /// Seed of the synthetic noise and of the chains.
     #[arg(long, default_value_t = motorcal::synthetic::DEFAULT_SEED)]
@@ -77,7 +77,7 @@ struct Table1Args {
     #[arg(long)]
     quick: bool,
     /// Samplers to run, comma separated.
-    #[arg(long, value_enum, value_delimiter = ',', default_values_t = [app::run::SamplerKind::Metropolis, app::run::SamplerKind::AdaptiveMetropolis])]
+    #[arg(long, value_enum, value_delimiter = ',', default_values_t = [app::run::SamplerKind::Metropolis, app::run::SamplerKind::AdaptiveMetropolis, app::run::SamplerKind::NutsDense])]
     samplers: Vec<app::run::SamplerKind>,
     /// Chains per run.
     #[arg(long, default_value_t = 3)]
@@ -278,7 +278,7 @@ fn bench(args: BenchArgs) -> Result<(), AppError> {
 }
 
 fn table1(args: Table1Args) -> Result<(), AppError> {
-    let options = app::table1::Table1Options {
+    run_table1(app::table1::Table1Options {
         seed: args.seed,
         quick: args.quick,
         samplers: args.samplers,
@@ -286,12 +286,15 @@ fn table1(args: Table1Args) -> Result<(), AppError> {
         threads: args.threads,
         out: args.out,
         quiet: args.quiet,
-    };
+    })
+}
+
+fn run_table1(options: app::table1::Table1Options) -> Result<(), AppError> {
     let report = app::table1::reproduce_table1(&options)?;
     print!("{}", app::table1::format_report(&report));
+    println!();
     println!(
-        "
-wrote {}/table1.json, table1.csv and the draws (CmdStan CSV)",
+        "wrote {}/table1.json, table1.csv, figures and the draws (CmdStan CSV)",
         options.out.display()
     );
     Ok(())
@@ -303,16 +306,7 @@ fn run(cli: Cli) -> Result<(), AppError> {
             println!(
                 "motorcal: reproducing the paper's Table 1 (see `motorcal --help` for the other commands)\n"
             );
-            table1(Table1Args {
-                samplers: vec![
-                    app::run::SamplerKind::Metropolis,
-                    app::run::SamplerKind::AdaptiveMetropolis,
-                ],
-                chains: 3,
-                seed: motorcal::synthetic::DEFAULT_SEED,
-                out: PathBuf::from("out/table1"),
-                ..Default::default()
-            })
+            run_table1(app::table1::Table1Options::default())
         }
         Some(Command::Reproduce {
             what: Reproduce::Table1(args),

@@ -39,7 +39,11 @@ impl Default for Table1Options {
         Self {
             seed: DEFAULT_SEED,
             quick: false,
-            samplers: vec![SamplerKind::Metropolis, SamplerKind::AdaptiveMetropolis],
+            samplers: vec![
+                SamplerKind::Metropolis,
+                SamplerKind::AdaptiveMetropolis,
+                SamplerKind::NutsDense,
+            ],
             chains: 3,
             threads: None,
             out: PathBuf::from("out/table1"),
