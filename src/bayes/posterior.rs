@@ -59,6 +59,13 @@ struct RecordTerm {
     channels: Vec<ChannelTerm>,
     cached: Cached,
     cached_theta: Vec<f64>,
+    /// The solve before the current one, kept so that a rejected proposal in θ costs no
+    /// second solve when the chain's next evaluation returns to the old θ (the paper's
+    /// variable-at-a-time Metropolis does exactly that, several times a sweep).
+    previous: Cached,
+    previous_theta: Vec<f64>,
+    previous_outputs: Vec<f64>,
+    previous_jacobian: DMatrix<f64>,
     outputs: Vec<f64>,
     jacobian: DMatrix<f64>,
     residual: Vec<f64>,
@@ -66,8 +73,20 @@ struct RecordTerm {
 
 impl RecordTerm {
     fn ensure_forward(&mut self, theta: &[f64], sensitivities: bool) -> Result<(), DensityError> {
-        let fresh = self.cached != Cached::Nothing && self.cached_theta.as_slice() == theta;
-        if fresh && (!sensitivities || self.cached == Cached::WithSensitivities) {
+        let usable = |kind: Cached, at: &[f64]| {
+            kind != Cached::Nothing
+                && at == theta
+                && (!sensitivities || kind == Cached::WithSensitivities)
+        };
+        if usable(self.cached, &self.cached_theta) {
+            return Ok(());
+        }
+        // Whatever happens next, the current solve becomes the previous one.
+        std::mem::swap(&mut self.cached, &mut self.previous);
+        std::mem::swap(&mut self.cached_theta, &mut self.previous_theta);
+        std::mem::swap(&mut self.outputs, &mut self.previous_outputs);
+        std::mem::swap(&mut self.jacobian, &mut self.previous_jacobian);
+        if usable(self.cached, &self.cached_theta) {
             return Ok(());
         }
         self.cached = Cached::Nothing;
@@ -215,6 +234,10 @@ impl CalibrationPosterior {
                 channels,
                 cached: Cached::Nothing,
                 cached_theta: Vec::new(),
+                previous: Cached::Nothing,
+                previous_theta: Vec::new(),
+                previous_outputs: vec![0.0; n_out],
+                previous_jacobian: DMatrix::zeros(n_out, n_par),
                 outputs: vec![0.0; n_out],
                 jacobian: DMatrix::zeros(n_out, n_par),
                 residual: vec![0.0; m],

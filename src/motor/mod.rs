@@ -69,6 +69,7 @@ impl MotorModel {
 
     /// Equations (3)–(4): L dI/dt = −R I − c_m ω + U and J dω/dt = c_g I − d ω − T_L, with the load
     /// torque opposing motion (the paper writes +T_L but only ever uses T_L = 0).
+    #[inline]
     pub fn rhs<D: DualNum<Primitive = f64> + Copy>(
         &self,
         voltage: D,
@@ -174,6 +175,7 @@ impl<D: DualNum<Primitive = f64> + Copy> OdeSystem<D> for MotorSystem<'_, D> {
         &self.segments.breakpoints
     }
 
+    #[inline]
     fn rhs(&self, _t: f64, segment: usize, y: &[D], dy: &mut [D]) {
         // The held value of the interval being integrated, not the value at t: a step that ends
         // exactly on a breakpoint must still see the old voltage in its last stage.
