@@ -377,43 +377,61 @@ fn dispatch(
                 FisherMalaAdaptation::default(),
             ))
         })?)),
-        SamplerKind::HmcDiag | SamplerKind::HmcDense => {
-            let kind = if settings.sampler == SamplerKind::HmcDense {
-                MetricKind::Dense
-            } else {
-                MetricKind::Diagonal
-            };
-            let loaded = load_adaptation(settings)?;
-            let runs = execute(posterior, inits, settings, label, |_| {
-                let kernel = match &loaded {
-                    Some(state) => Hmc::from_adaptation(state, HmcSettings::default()),
-                    None => Hmc::new(warm_metric(map, kind)?, HmcSettings::default()),
-                }
-                .map_err(fatal)?;
-                Ok((kernel, hamiltonian_adaptation(loaded.is_some())))
-            })?;
-            save_adaptation(settings, runs.first().map(|(_, k)| AdaptationState::of(k)))?;
-            Ok(outputs(runs))
-        }
-        SamplerKind::NutsDiag | SamplerKind::NutsDense => {
-            let kind = if settings.sampler == SamplerKind::NutsDense {
-                MetricKind::Dense
-            } else {
-                MetricKind::Diagonal
-            };
-            let loaded = load_adaptation(settings)?;
-            let runs = execute(posterior, inits, settings, label, |_| {
-                let kernel = match &loaded {
-                    Some(state) => Nuts::from_adaptation(state, NutsSettings::default()),
-                    None => Nuts::new(warm_metric(map, kind)?, NutsSettings::default()),
-                }
-                .map_err(fatal)?;
-                Ok((kernel, hamiltonian_adaptation(loaded.is_some())))
-            })?;
-            save_adaptation(settings, runs.first().map(|(_, k)| AdaptationState::of(k)))?;
-            Ok(outputs(runs))
-        }
+        SamplerKind::HmcDiag | SamplerKind::HmcDense => hamiltonian(
+            posterior,
+            map,
+            inits,
+            settings,
+            label,
+            |loaded, metric| match loaded {
+                Some(state) => Hmc::from_adaptation(state, HmcSettings::default()),
+                None => Hmc::new(metric, HmcSettings::default()),
+            },
+        ),
+        SamplerKind::NutsDiag | SamplerKind::NutsDense => hamiltonian(
+            posterior,
+            map,
+            inits,
+            settings,
+            label,
+            |loaded, metric| match loaded {
+                Some(state) => Nuts::from_adaptation(state, NutsSettings::default()),
+                None => Nuts::new(metric, NutsSettings::default()),
+            },
+        ),
     }
+}
+
+/// HMC or NUTS: the metric warm-started from the MAP (dense or its diagonal, by the sampler's
+/// name) or a reloaded adaptation, Stan's windows unless reloaded, and the adaptation saved.
+fn hamiltonian<K, B>(
+    posterior: &CalibrationPosterior,
+    map: &MapEstimate,
+    inits: &[Vec<f64>],
+    settings: &RunSettings,
+    label: &str,
+    build: B,
+) -> Result<Vec<ChainOutput>, AppError>
+where
+    K: Kernel<Counted<CalibrationPosterior>> + HamiltonianKernel + Send,
+    B: Fn(Option<&AdaptationState>, Metric) -> Result<K, String> + Sync,
+{
+    let kind = if matches!(
+        settings.sampler,
+        SamplerKind::HmcDense | SamplerKind::NutsDense
+    ) {
+        MetricKind::Dense
+    } else {
+        MetricKind::Diagonal
+    };
+    let loaded = load_adaptation(settings)?;
+    let runs = execute(posterior, inits, settings, label, |_| {
+        let kernel =
+            build(loaded.as_ref(), warm_metric(map, kind)?).map_err(DensityError::fatal)?;
+        Ok((kernel, hamiltonian_adaptation(loaded.is_some())))
+    })?;
+    save_adaptation(settings, runs.first().map(|(_, k)| AdaptationState::of(k)))?;
+    Ok(outputs(runs))
 }
 
 fn outputs<K>(runs: Vec<(ChainOutput, K)>) -> Vec<ChainOutput> {

@@ -337,7 +337,10 @@ impl FisherMalaAdaptation {
     /// Dual averaging starts from the kernel's step size at the first warm-up transition.
     pub fn new(settings: DualAveragingSettings) -> Result<Self, String> {
         Ok(Self {
-            dual: DualAveraging::new(settings, 1.0)?,
+            dual: {
+                settings.validate()?;
+                DualAveraging::new(&settings, 1.0)
+            },
         })
     }
 }
@@ -345,7 +348,7 @@ impl FisherMalaAdaptation {
 impl Default for FisherMalaAdaptation {
     /// Dual averaging toward [`FISHER_MALA_TARGET_ACCEPT`] with the default γ, t₀ and κ.
     fn default() -> Self {
-        Self::new(DualAveragingSettings::with_target(
+        Self::new(DualAveragingSettings::single_proposal(
             FISHER_MALA_TARGET_ACCEPT,
         ))
         .expect("the default settings are valid")

@@ -14,6 +14,7 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;
 use serde::{Deserialize, Serialize};
 
+pub use super::adapt::{DualAveraging, DualAveragingSettings};
 use super::{Adaptation, Info, Kernel, State};
 use crate::density::{DensityError, LogDensity};
 
@@ -389,127 +390,6 @@ impl<P: LogDensity> Kernel<P> for Mala {
     }
 }
 
-/// Dual averaging of log ε toward a target acceptance (Nesterov 2009; Hoffman & Gelman 2014,
-/// §3.2; Stan's t₀ and κ, a larger γ). Restartable, for when the preconditioner changes.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct DualAveragingSettings {
-    pub target_accept: f64,
-    /// Shrinkage of log ε toward μ = log(10 ε₀): how boldly early iterations move. Stan's
-    /// 0.05 suits NUTS, whose statistic averages a whole trajectory; the single-proposal
-    /// statistic of MALA is noisier, the iterates scatter more in log ε, and because
-    /// acceptance is concave in log ε near the target the frozen average then accepts too
-    /// often (0.61–0.66 for 0.574 after 300–1000 warm-up transitions on an 8-d Gaussian).
-    /// 0.1 halves that bias and is no worse after long warm-ups.
-    pub gamma: f64,
-    /// Damps the first iterations.
-    pub t0: f64,
-    /// Decay of the averaging weights: the averaged ε forgets early iterations like t^-κ.
-    pub kappa: f64,
-}
-
-impl Default for DualAveragingSettings {
-    fn default() -> Self {
-        Self {
-            target_accept: 0.574,
-            gamma: 0.1,
-            t0: 10.0,
-            kappa: 0.75,
-        }
-    }
-}
-
-impl DualAveragingSettings {
-    pub fn with_target(target_accept: f64) -> Self {
-        Self {
-            target_accept,
-            ..Self::default()
-        }
-    }
-
-    pub fn validate(&self) -> Result<(), String> {
-        if !(self.target_accept > 0.0 && self.target_accept < 1.0) {
-            return Err(format!(
-                "the target acceptance must lie in (0, 1), not {}",
-                self.target_accept
-            ));
-        }
-        if !(self.gamma > 0.0 && self.t0 >= 0.0 && self.kappa > 0.5 && self.kappa <= 1.0) {
-            return Err("dual averaging needs γ > 0, t₀ ≥ 0 and κ in (0.5, 1]".into());
-        }
-        Ok(())
-    }
-}
-
-const LOG_STEP_BOUND: f64 = 300.0;
-
-/// The dual-averaging controller's state.
-#[derive(Clone, Debug)]
-pub struct DualAveraging {
-    settings: DualAveragingSettings,
-    mu: f64,
-    h_bar: f64,
-    log_step_bar: f64,
-    t: f64,
-}
-
-impl DualAveraging {
-    pub fn new(settings: DualAveragingSettings, initial_step_size: f64) -> Result<Self, String> {
-        settings.validate()?;
-        if !(initial_step_size > 0.0 && initial_step_size.is_finite()) {
-            return Err(format!(
-                "the initial step size must be positive and finite, not {initial_step_size}"
-            ));
-        }
-        let mut da = Self {
-            settings,
-            mu: 0.0,
-            h_bar: 0.0,
-            log_step_bar: 0.0,
-            t: 0.0,
-        };
-        da.restart(initial_step_size);
-        Ok(da)
-    }
-
-    pub fn settings(&self) -> &DualAveragingSettings {
-        &self.settings
-    }
-
-    /// Starts afresh from `step_size` (forgetting the averages).
-    pub fn restart(&mut self, step_size: f64) {
-        self.mu = (10.0 * step_size).ln();
-        self.h_bar = 0.0;
-        self.log_step_bar = step_size.ln();
-        self.t = 0.0;
-    }
-
-    /// Feeds one transition's acceptance statistic; returns the step size to use next.
-    pub fn update(&mut self, accept_stat: f64) -> f64 {
-        let s = &self.settings;
-        let accept = if accept_stat.is_finite() {
-            accept_stat.clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        self.t += 1.0;
-        let w = 1.0 / (self.t + s.t0);
-        self.h_bar = (1.0 - w) * self.h_bar + w * (s.target_accept - accept);
-        // Bounded so that a long run of rejections cannot drive ε to exactly 0 (or ∞), where
-        // the proposal densities would be 0/0.
-        let log_step =
-            (self.mu - self.t.sqrt() / s.gamma * self.h_bar).clamp(-LOG_STEP_BOUND, LOG_STEP_BOUND);
-        let eta = self.t.powf(-s.kappa);
-        self.log_step_bar = eta * log_step + (1.0 - eta) * self.log_step_bar;
-        log_step.exp()
-    }
-
-    /// The averaged step size: the one to freeze.
-    pub fn final_step_size(&self) -> f64 {
-        self.log_step_bar.exp()
-    }
-}
-
 /// How the warm-up re-estimates M⁻¹.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -541,7 +421,7 @@ pub struct MalaAdaptationSettings {
 impl Default for MalaAdaptationSettings {
     fn default() -> Self {
         Self {
-            step_size: DualAveragingSettings::default(),
+            step_size: DualAveragingSettings::single_proposal(0.574),
             preconditioner: PreconditionerAdaptation::Fixed,
             initial_buffer: 0.075,
             final_buffer: 0.05,
@@ -587,7 +467,8 @@ impl MalaAdaptation {
     /// Dual averaging starts from the kernel's step size at the first warm-up transition.
     pub fn new(settings: MalaAdaptationSettings) -> Result<Self, String> {
         settings.validate()?;
-        let dual = DualAveraging::new(settings.step_size.clone(), 1.0)?;
+        settings.step_size.validate()?;
+        let dual = DualAveraging::new(&settings.step_size, 1.0);
         Ok(Self {
             settings,
             dual,
