@@ -218,6 +218,8 @@ pub fn bench(options: &BenchOptions) -> Result<Vec<BenchRecord>, AppError> {
                     eprintln!("{}", format_record(&r));
                 }
                 records.push(r);
+                // Written after every record: a long bench that is stopped keeps what it measured.
+                write_records(options, &records)?;
             }
         }
     }
@@ -313,7 +315,7 @@ pub fn format_table(records: &[BenchRecord]) -> String {
     out
 }
 
-fn write_outputs(options: &BenchOptions, records: &[BenchRecord]) -> Result<(), AppError> {
+fn write_records(options: &BenchOptions, records: &[BenchRecord]) -> Result<(), AppError> {
     let json =
         serde_json::to_string_pretty(records).map_err(|e| AppError::Output(e.to_string()))?;
     let json_path = options
@@ -348,6 +350,11 @@ fn write_outputs(options: &BenchOptions, records: &[BenchRecord]) -> Result<(), 
         ));
     }
     crate::io::write_atomically(&options.out.join("bench.csv"), csv.as_bytes())?;
+    Ok(())
+}
+
+fn write_outputs(options: &BenchOptions, records: &[BenchRecord]) -> Result<(), AppError> {
+    write_records(options, records)?;
     for threads in options.threads.iter().copied() {
         let curves = |value: fn(&BenchRecord) -> f64| -> Vec<SamplerCurve> {
             options
