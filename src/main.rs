@@ -242,6 +242,9 @@ struct BenchArgs {
     json: Option<PathBuf>,
     #[arg(long)]
     quiet: bool,
+    /// Redraw the table, CSV and figures from an earlier run's bench.json (no measuring).
+    #[arg(long)]
+    from_json: Option<PathBuf>,
 }
 
 fn bench(args: BenchArgs) -> Result<(), AppError> {
@@ -267,6 +270,7 @@ fn bench(args: BenchArgs) -> Result<(), AppError> {
         out: args.out,
         json: args.json,
         quiet: args.quiet,
+        from_json: args.from_json,
     };
     let records = app::bench::bench(&options)?;
     print!("{}", app::bench::format_table(&records));

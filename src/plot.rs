@@ -131,7 +131,8 @@ pub struct SamplerCurve {
     /// Sampler name, shown in the legend.
     pub sampler: String,
     /// Points `(k, value, lower_bound)`; `lower_bound` marks values from unconverged runs,
-    /// which are only lower bounds and are drawn hollow with an upward arrow.
+    /// which overstate the sampler (its ratios are lower bounds) and are drawn hollow with a
+    /// downward arrow.
     pub points: Vec<(f64, f64, bool)>,
 }
 
@@ -593,8 +594,8 @@ pub fn traces(path: &Path, title: &str, series: &[TraceSeries]) -> Result<(), Pl
 }
 
 /// Sampler efficiency against the discrepancy degree K on a logarithmic y axis: one line
-/// with markers per sampler; values from unconverged runs (lower bounds) are drawn hollow
-/// with an upward arrow, which the legend explains. `y_label` names the quantity, e.g.
+/// with markers per sampler; values from unconverged runs (which overstate the sampler) are
+/// drawn hollow with a downward arrow, which the legend explains. `y_label` names the quantity, e.g.
 /// "min ESS per second [1/s]" or "min ESS per gradient evaluation".
 pub fn ess_per_second(
     path: &Path,
@@ -687,7 +688,7 @@ pub fn ess_per_second(
         }
         if any_lower {
             p.legend_item(
-                "lower bound (chains not converged)",
+                "not converged: at most this (ratios against it are lower bounds)",
                 Icon::Marker {
                     shape: Shape::Circle,
                     color: C_GREY.to_rgba(),
@@ -1494,7 +1495,8 @@ impl<'a, 'b> Panel<'a, 'b> {
         Ok(())
     }
 
-    /// Upward arrows above markers of radius `r` (lower bounds).
+    /// Downward arrows below markers of radius `r`: an unconverged run's ESS overstates it, so
+    /// its true efficiency lies below the point.
     fn arrows(&mut self, pts: &[(f64, f64)], r: i32, color: RGBAColor) -> Result<(), PlotError> {
         let pts: Vec<(f64, f64)> = pts
             .iter()
@@ -1502,11 +1504,8 @@ impl<'a, 'b> Panel<'a, 'b> {
             .collect();
         self.chart.draw_series(pts.into_iter().map(|p| {
             EmptyElement::at(p)
-                + PathElement::new(vec![(0, -r - 2), (0, -r - 14)], color.stroke_width(2))
-                + Polygon::new(
-                    vec![(-5, -r - 12), (5, -r - 12), (0, -r - 21)],
-                    color.filled(),
-                )
+                + PathElement::new(vec![(0, r + 2), (0, r + 14)], color.stroke_width(2))
+                + Polygon::new(vec![(-5, r + 12), (5, r + 12), (0, r + 21)], color.filled())
         }))?;
         Ok(())
     }
@@ -1679,11 +1678,11 @@ fn draw_icon(area: &Area<'_>, icon: &Icon, x: i32, y: i32) -> Result<(), PlotErr
             if arrow {
                 let ax = x + 28;
                 area.draw(&PathElement::new(
-                    vec![(ax, y + 8), (ax, y - 3)],
+                    vec![(ax, y - 8), (ax, y + 3)],
                     color.stroke_width(2),
                 ))?;
                 area.draw(&Polygon::new(
-                    vec![(ax - 5, y - 2), (ax + 5, y - 2), (ax, y - 10)],
+                    vec![(ax - 5, y + 2), (ax + 5, y + 2), (ax, y + 10)],
                     color.filled(),
                 ))?;
             }

@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::bayes::ModelSettings;
 use crate::plot::{self, SamplerCurve};
@@ -37,6 +37,8 @@ pub struct BenchOptions {
     pub out: PathBuf,
     pub json: Option<PathBuf>,
     pub quiet: bool,
+    /// Redraw the table and figures from an earlier run's JSON instead of measuring.
+    pub from_json: Option<PathBuf>,
 }
 
 impl Default for BenchOptions {
@@ -57,12 +59,13 @@ impl Default for BenchOptions {
             out: PathBuf::from("out/bench"),
             json: None,
             quiet: false,
+            from_json: None,
         }
     }
 }
 
 /// One (sampler, K, threads) measurement: the stable contract of `--json`.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct BenchRecord {
     pub sampler: String,
     pub k: usize,
@@ -180,6 +183,23 @@ fn record(
 }
 
 pub fn bench(options: &BenchOptions) -> Result<Vec<BenchRecord>, AppError> {
+    if let Some(path) = &options.from_json {
+        let text = std::fs::read_to_string(path).map_err(|e| {
+            AppError::Input(crate::io::InputError::new(
+                path,
+                format!("cannot read: {e}"),
+            ))
+        })?;
+        let records: Vec<BenchRecord> = serde_json::from_str(&text).map_err(|e| {
+            AppError::Input(crate::io::InputError::new(path, e.to_string()).at_line(e.line()))
+        })?;
+        let mut options = options.clone();
+        options.threads = records.iter().map(|r| r.threads).collect();
+        options.threads.sort();
+        options.threads.dedup();
+        write_outputs(&options, &records)?;
+        return Ok(records);
+    }
     if options.ks.is_empty() || options.samplers.is_empty() || options.threads.is_empty() {
         return Err(AppError::Usage(
             "bench: name at least one K, sampler and thread count".into(),
