@@ -8,11 +8,10 @@
 //! off by orders of magnitude would otherwise leave the chain stuck and its history uninformative.
 
 use nalgebra::DMatrix;
-use rand::RngExt;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 
-use super::{Adaptation, Info, Kernel, State};
+use super::{Adaptation, Info, Kernel, State, proposal_log_density, random_walk_decision};
 use crate::density::{DensityError, LogDensity};
 
 /// The ridge is relative to each coordinate's own variance, i.e. added to the correlation
@@ -176,22 +175,8 @@ impl<P: LogDensity> Kernel<P> for AdaptiveMetropolis {
             }
             self.proposal[i] = state.x[i] + self.scale * step;
         }
-        let proposed = match density.log_density(&self.proposal) {
-            Ok(lp) => lp,
-            Err(e) if e.recoverable => f64::NEG_INFINITY,
-            Err(e) => return Err(e),
-        };
-        let log_ratio = proposed - state.log_density;
-        // −∞ (outside the support, or a failed solve) gives probability 0; so does NaN.
-        let accept_prob = if log_ratio >= 0.0 {
-            1.0
-        } else if log_ratio.is_nan() {
-            0.0
-        } else {
-            log_ratio.exp()
-        };
-        let accepted =
-            accept_prob >= 1.0 || (accept_prob > 0.0 && rng.random::<f64>() < accept_prob);
+        let proposed = proposal_log_density(density, &self.proposal)?;
+        let (accept_prob, accepted) = random_walk_decision(proposed, state.log_density, rng);
         if accepted {
             state.x.copy_from_slice(&self.proposal);
             state.log_density = proposed;

@@ -10,11 +10,10 @@
 
 use std::ops::Range;
 
-use rand::RngExt;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 
-use super::{Adaptation, Info, Kernel, State};
+use super::{Adaptation, Info, Kernel, State, proposal_log_density, random_walk_decision};
 use crate::density::{DensityError, LogDensity};
 
 /// Variable-at-a-time Gaussian random-walk Metropolis over the density's blocks.
@@ -129,23 +128,8 @@ impl<P: LogDensity> Kernel<P> for Metropolis {
                 let z: f64 = StandardNormal.sample(rng);
                 *v += scale * z;
             }
-            let proposed = match density.log_density(&self.proposal) {
-                Ok(lp) => lp,
-                Err(e) if e.recoverable => f64::NEG_INFINITY,
-                Err(e) => return Err(e),
-            };
-            // −∞ (outside the support, or a recoverable failure) gives probability 0; so does
-            // NaN, which would otherwise slip through every comparison.
-            let log_ratio = proposed - state.log_density;
-            let accept_prob = if log_ratio >= 0.0 {
-                1.0
-            } else if log_ratio.is_nan() {
-                0.0
-            } else {
-                log_ratio.exp()
-            };
-            let accepted =
-                accept_prob >= 1.0 || (accept_prob > 0.0 && rng.random::<f64>() < accept_prob);
+            let proposed = proposal_log_density(density, &self.proposal)?;
+            let (accept_prob, accepted) = random_walk_decision(proposed, state.log_density, rng);
             if accepted {
                 state.x[block.clone()].copy_from_slice(&self.proposal[block.clone()]);
                 state.log_density = proposed;

@@ -107,3 +107,37 @@ impl<K> Adaptation<K> for NoAdaptation {
     fn observe(&mut self, _: &mut K, _: &State, _: &Info, _: usize, _: usize) {}
     fn finish(&mut self, _: &mut K) {}
 }
+
+/// The log density at a random-walk proposal: a recoverable failure counts as zero density, so
+/// the proposal is rejected like one outside the support.
+pub(crate) fn proposal_log_density<P: LogDensity>(
+    density: &mut P,
+    x: &[f64],
+) -> Result<f64, DensityError> {
+    match density.log_density(x) {
+        Ok(lp) => Ok(lp),
+        Err(e) if e.recoverable => Ok(f64::NEG_INFINITY),
+        Err(e) => Err(e),
+    }
+}
+
+/// The Metropolis decision for a symmetric proposal: the acceptance probability and whether
+/// the proposal is taken. −∞ (outside the support, or a failed solve) and NaN give
+/// probability 0; a uniform is drawn only when the decision is not already certain.
+pub(crate) fn random_walk_decision(
+    proposed: f64,
+    current: f64,
+    rng: &mut ChaCha8Rng,
+) -> (f64, bool) {
+    use rand::RngExt;
+    let log_ratio = proposed - current;
+    let accept_prob = if log_ratio >= 0.0 {
+        1.0
+    } else if log_ratio.is_nan() {
+        0.0
+    } else {
+        log_ratio.exp()
+    };
+    let accepted = accept_prob >= 1.0 || (accept_prob > 0.0 && rng.random::<f64>() < accept_prob);
+    (accept_prob, accepted)
+}
