@@ -181,16 +181,13 @@ impl<P: LogDensity> Kernel<P> for AdaptiveMetropolis {
             state.x.copy_from_slice(&self.proposal);
             state.log_density = proposed;
         }
-        Ok(Info {
-            accept_stat: accept_prob,
+        Ok(Info::single_proposal(
+            accept_prob,
             accepted,
-            divergent: false,
-            step_size: self.scale,
-            tree_depth: 0,
-            n_steps: 1,
-            energy: -state.log_density,
-            block_accepted: Vec::new(),
-        })
+            false,
+            self.scale,
+            state.log_density,
+        ))
     }
 }
 

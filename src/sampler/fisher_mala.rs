@@ -304,16 +304,13 @@ impl<P: FisherMetric> Kernel<P> for FisherMala {
             std::mem::swap(&mut self.current, &mut self.candidate);
             state.log_density = lp_new;
         }
-        Ok(Info {
+        Ok(Info::single_proposal(
             accept_stat,
             accepted,
-            divergent: failed,
-            step_size: eps,
-            tree_depth: 0,
-            n_steps: 1,
-            energy: -state.log_density,
-            block_accepted: Vec::new(),
-        })
+            failed,
+            eps,
+            state.log_density,
+        ))
     }
 }
 

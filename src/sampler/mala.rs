@@ -377,16 +377,13 @@ impl<P: LogDensity> Kernel<P> for Mala {
             std::mem::swap(&mut state.gradient, &mut self.proposal_gradient);
             state.log_density = lp_new;
         }
-        Ok(Info {
+        Ok(Info::single_proposal(
             accept_stat,
             accepted,
-            divergent: failed,
-            step_size: eps,
-            tree_depth: 0,
-            n_steps: 1,
-            energy: -state.log_density,
-            block_accepted: Vec::new(),
-        })
+            failed,
+            eps,
+            state.log_density,
+        ))
     }
 }
 

@@ -50,6 +50,29 @@ pub struct Info {
     pub block_accepted: Vec<bool>,
 }
 
+impl Info {
+    /// The record of a kernel that makes one proposal per transition (MALA, Fisher-MALA,
+    /// adaptive Metropolis): no tree, one step, energy −log π at the state it ends in.
+    pub fn single_proposal(
+        accept_stat: f64,
+        accepted: bool,
+        divergent: bool,
+        step_size: f64,
+        log_density: f64,
+    ) -> Self {
+        Self {
+            accept_stat,
+            accepted,
+            divergent,
+            step_size,
+            tree_depth: 0,
+            n_steps: 1,
+            energy: -log_density,
+            block_accepted: Vec::new(),
+        }
+    }
+}
+
 /// A transition kernel. `step` must leave `state` a valid state of the chain even when the
 /// density fails recoverably (the proposal is then rejected).
 pub trait Kernel<P: LogDensity> {
