@@ -6,6 +6,7 @@ use num_dual::{Dual64, DualNum, DualSVec64};
 
 use crate::motor::{MotorModel, Segments};
 use crate::ode::{self, OdeError, SolverSettings, SolverStats};
+use crate::parameter::ParameterSpec;
 
 /// G(θ) for one recording: which parameters are free, at which times the channels are sampled.
 #[derive(Clone, Debug)]
@@ -22,11 +23,12 @@ pub struct ForwardModel {
 const T0: f64 = 0.0;
 
 impl ForwardModel {
-    /// `calibrated` names the free parameters (keys of the model's parameter vector, e.g. "R").
-    pub fn new(
+    /// `calibrated` names the free parameters (keys of the model's parameter vector, e.g. "R"
+    /// or "coulomb_friction.T_c").
+    pub fn new<S: AsRef<str>>(
         model: MotorModel,
         times: Vec<f64>,
-        calibrated: &[&str],
+        calibrated: &[S],
         solver: SolverSettings,
     ) -> Result<Self, String> {
         if times.is_empty() {
@@ -35,17 +37,23 @@ impl ForwardModel {
         if times[0] < T0 || times.windows(2).any(|w| !(w[1] > w[0])) {
             return Err("sample times must be non-negative and strictly increasing".into());
         }
+        let names = model.parameter_names();
         let calibrated = calibrated
             .iter()
             .map(|name| {
-                model.parameter_index(name).ok_or_else(|| {
-                    format!(
-                        "unknown parameter '{name}' (known: {})",
-                        model.parameter_names().join(", ")
-                    )
-                })
+                let name = name.as_ref();
+                let index = names.iter().position(|n| n == name).ok_or_else(|| {
+                    format!("unknown parameter '{name}' (known: {})", names.join(", "))
+                })?;
+                model.check_calibrated(name)?;
+                Ok(index)
             })
-            .collect::<Result<Vec<_>, _>>()?;
+            .collect::<Result<Vec<_>, String>>()?;
+        for (k, i) in calibrated.iter().enumerate() {
+            if calibrated[..k].contains(i) {
+                return Err(format!("parameter '{}' is calibrated twice", names[*i]));
+            }
+        }
         let segments = model.segments(T0);
         let nominal = model.parameter_values();
         Ok(Self {
@@ -83,9 +91,17 @@ impl ForwardModel {
         self.calibrated.len()
     }
 
-    pub fn calibrated_names(&self) -> Vec<&'static str> {
+    pub fn calibrated_names(&self) -> Vec<String> {
         let names = self.model.parameter_names();
-        self.calibrated.iter().map(|&i| names[i]).collect()
+        self.calibrated.iter().map(|&i| names[i].clone()).collect()
+    }
+
+    /// The calibrated parameters as the model declares them, default priors scaled to this
+    /// model and this recording's length.
+    pub fn calibrated_specs(&self) -> Vec<ParameterSpec> {
+        let duration = self.times.last().copied().unwrap_or(0.0) - T0;
+        let specs = self.model.parameter_specs(&self.model.magnitudes(duration));
+        self.calibrated.iter().map(|&i| specs[i].clone()).collect()
     }
 
     /// Nominal values of the calibrated parameters.

@@ -19,6 +19,7 @@ pub mod io;
 pub mod motor;
 pub mod ode;
 pub mod optimize;
+pub mod parameter;
 pub mod plot;
 pub mod sampler;
 pub mod synthetic;

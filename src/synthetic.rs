@@ -77,7 +77,7 @@ pub fn generate(
     let forward = ForwardModel::new(
         model.clone(),
         times.to_vec(),
-        &[],
+        &[] as &[&str],
         SolverSettings::for_data_generation(),
     )
     .map_err(OdeError::BadOutputTimes)?;

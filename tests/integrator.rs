@@ -14,7 +14,7 @@ fn paper_times() -> Vec<f64> {
 fn exact(params: &[f64], times: &[f64]) -> Vec<[f64; 2]> {
     times
         .iter()
-        .map(|&t| constant_voltage_solution(params, t).unwrap())
+        .map(|&t| constant_voltage_solution(params, 0.0, t).unwrap())
         .collect()
 }
 
@@ -85,7 +85,7 @@ fn dual_number_sensitivity_in_r_matches_the_closed_form_and_finite_differences()
         let exact: Vec<f64> = fm
             .times()
             .iter()
-            .map(|&t| constant_voltage_solution(&p, t).unwrap()[c].eps)
+            .map(|&t| constant_voltage_solution(&p, Dual64::from(0.0), t).unwrap()[c].eps)
             .collect();
         let scale = exact.iter().map(|v| v.abs()).fold(0.0, f64::max);
         for i in 0..m {
@@ -134,7 +134,7 @@ fn several_calibrated_parameters_give_one_column_each() {
             .times()
             .iter()
             .map(|&t| {
-                let x = constant_voltage_solution(&p, t).unwrap();
+                let x = constant_voltage_solution(&p, Dual64::from(0.0), t).unwrap();
                 [x[0].eps, x[1].eps]
             })
             .collect();
@@ -202,7 +202,7 @@ fn a_held_voltage_is_integrated_piecewise_exactly() {
             p[MotorParam::InitialSpeed as usize] = state[1];
             p[MotorParam::Voltage as usize] =
                 values[times.partition_point(|&x| x <= start).saturating_sub(1)];
-            let x = constant_voltage_solution(&p, s - start).unwrap();
+            let x = constant_voltage_solution(&p, 0.0, s - start).unwrap();
             state = x;
             start = s;
         }
@@ -210,7 +210,7 @@ fn a_held_voltage_is_integrated_piecewise_exactly() {
         p[MotorParam::InitialSpeed as usize] = state[1];
         let u_index = times.partition_point(|&x| x <= start).saturating_sub(1);
         p[MotorParam::Voltage as usize] = values[u_index];
-        let x = constant_voltage_solution(&p, t - start).unwrap();
+        let x = constant_voltage_solution(&p, 0.0, t - start).unwrap();
         for c in 0..2 {
             worst[c] = worst[c].max((out[c * m + i] - x[c]).abs());
             scale[c] = scale[c].max(x[c].abs());

@@ -114,7 +114,7 @@ fn paper_reference(
     let forward = ForwardModel::new(
         simulation,
         data.times.clone(),
-        &[],
+        &[] as &[&str],
         SolverSettings::for_data_generation(),
     )
     .map_err(AppError::Usage)?;

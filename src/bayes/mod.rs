@@ -1,11 +1,12 @@
 //! The Bayesian models of §3: priors, discrepancy bases, and the posterior as a log density.
 
 pub mod basis;
+mod calibrated;
 mod posterior;
-mod prior;
 mod settings;
 
+pub use crate::parameter::{Prior, ln_gamma};
 pub use basis::{DiscrepancyBasis, Legendre};
+pub use calibrated::{CalibratedParameter, PriorInU};
 pub use posterior::{CalibrationPosterior, Observations};
-pub use prior::{Prior, ln_gamma};
-pub use settings::{CoefficientFamily, CoefficientPrior, ModelSettings, SpreadReading};
+pub use settings::{BasisKind, CoefficientFamily, CoefficientPrior, ModelSettings, SpreadReading};

@@ -1,5 +1,6 @@
 //! The posterior of BM1/BM2 (eqs. 12–22) over the unconstrained coordinates
-//! x = (θ, log σ per record and channel, discrepancy coefficients per record and channel).
+//! x = (u(θ), log σ per record and channel, discrepancy coefficients per record and channel),
+//! where each calibrated physical parameter θ_k is reached through its own transform u_k.
 //!
 //! The likelihood is per channel and per recording, each with its own noise level; the
 //! discrepancy basis is per channel. The gradient in θ comes from the forward sensitivities,
@@ -10,12 +11,11 @@ use std::ops::Range;
 
 use nalgebra::DMatrix;
 
-use super::basis::{DiscrepancyBasis, Legendre};
-use super::prior::Prior;
+use super::calibrated::{CalibratedParameter, PriorInU};
 use super::settings::ModelSettings;
 use crate::density::{DensityError, FisherMetric, LogDensity};
 use crate::forward::ForwardModel;
-use crate::motor::MotorParam;
+use crate::parameter::{Prior, Transform};
 
 const LN_2PI: f64 = 1.837_877_066_409_345_5;
 
@@ -52,54 +52,67 @@ enum Cached {
     WithSensitivities,
 }
 
+/// One solve of the forward model: at which θ, how much of it, and what it gave.
+#[derive(Clone, Debug)]
+struct Solve {
+    kind: Cached,
+    theta: Vec<f64>,
+    outputs: Vec<f64>,
+    jacobian: DMatrix<f64>,
+}
+
+impl Solve {
+    fn empty(n_out: usize, n_par: usize) -> Self {
+        Self {
+            kind: Cached::Nothing,
+            theta: Vec::new(),
+            outputs: vec![0.0; n_out],
+            jacobian: DMatrix::zeros(n_out, n_par),
+        }
+    }
+
+    fn serves(&self, theta: &[f64], sensitivities: bool) -> bool {
+        self.kind != Cached::Nothing
+            && self.theta == theta
+            && (!sensitivities || self.kind == Cached::WithSensitivities)
+    }
+}
+
 #[derive(Clone, Debug)]
 struct RecordTerm {
     label: String,
     forward: ForwardModel,
     channels: Vec<ChannelTerm>,
-    cached: Cached,
-    cached_theta: Vec<f64>,
+    current: Solve,
     /// The solve before the current one, kept so that a rejected proposal in θ costs no
     /// second solve when the chain's next evaluation returns to the old θ (the paper's
     /// variable-at-a-time Metropolis does exactly that, several times a sweep).
-    previous: Cached,
-    previous_theta: Vec<f64>,
-    previous_outputs: Vec<f64>,
-    previous_jacobian: DMatrix<f64>,
-    outputs: Vec<f64>,
-    jacobian: DMatrix<f64>,
+    previous: Solve,
     residual: Vec<f64>,
 }
 
 impl RecordTerm {
     fn ensure_forward(&mut self, theta: &[f64], sensitivities: bool) -> Result<(), DensityError> {
-        let usable = |kind: Cached, at: &[f64]| {
-            kind != Cached::Nothing
-                && at == theta
-                && (!sensitivities || kind == Cached::WithSensitivities)
-        };
-        if usable(self.cached, &self.cached_theta) {
+        if self.current.serves(theta, sensitivities) {
             return Ok(());
         }
         // Whatever happens next, the current solve becomes the previous one.
-        std::mem::swap(&mut self.cached, &mut self.previous);
-        std::mem::swap(&mut self.cached_theta, &mut self.previous_theta);
-        std::mem::swap(&mut self.outputs, &mut self.previous_outputs);
-        std::mem::swap(&mut self.jacobian, &mut self.previous_jacobian);
-        if usable(self.cached, &self.cached_theta) {
+        std::mem::swap(&mut self.current, &mut self.previous);
+        if self.current.serves(theta, sensitivities) {
             return Ok(());
         }
-        self.cached = Cached::Nothing;
+        let solve = &mut self.current;
+        solve.kind = Cached::Nothing;
         let result = if sensitivities {
             self.forward
-                .simulate_with_sensitivities(theta, &mut self.outputs, &mut self.jacobian)
+                .simulate_with_sensitivities(theta, &mut solve.outputs, &mut solve.jacobian)
         } else {
-            self.forward.simulate(theta, &mut self.outputs)
+            self.forward.simulate(theta, &mut solve.outputs)
         };
         result.map_err(|e| DensityError::recoverable(format!("{}: {e}", self.label)))?;
-        self.cached_theta.clear();
-        self.cached_theta.extend_from_slice(theta);
-        self.cached = if sensitivities {
+        solve.theta.clear();
+        solve.theta.extend_from_slice(theta);
+        solve.kind = if sensitivities {
             Cached::WithSensitivities
         } else {
             Cached::Values
@@ -111,7 +124,7 @@ impl RecordTerm {
     fn residual(&mut self, c: usize, x: &[f64]) {
         let m = self.forward.n_samples();
         let ch = &self.channels[c];
-        let g = &self.outputs[c * m..(c + 1) * m];
+        let g = &self.current.outputs[c * m..(c + 1) * m];
         for ((r, &y), &gi) in self.residual.iter_mut().zip(&ch.observed).zip(g) {
             *r = y - gi;
         }
@@ -125,15 +138,22 @@ impl RecordTerm {
             }
         }
     }
+
+    /// Sensitivities of channel `c` to θ_k.
+    fn sensitivities(&self, k: usize, c: usize) -> &[f64] {
+        let m = self.forward.n_samples();
+        column_rows(&self.current.jacobian, k, c * m..(c + 1) * m)
+    }
 }
 
 /// The posterior of one or several recordings under BM1 or BM2(K).
 #[derive(Clone, Debug)]
 pub struct CalibrationPosterior {
     settings: ModelSettings,
+    theta: Vec<CalibratedParameter>,
     theta_names: Vec<String>,
-    theta_priors: Vec<Prior>,
-    theta_positive: Vec<bool>,
+    /// θ in the model's own coordinates at the last evaluation (scratch).
+    theta_x: Vec<f64>,
     noise_prior: Prior,
     records: Vec<RecordTerm>,
     dim: usize,
@@ -143,29 +163,51 @@ pub struct CalibrationPosterior {
 }
 
 impl CalibrationPosterior {
-    /// Builds the posterior. Every record's forward model must calibrate the same parameters.
+    /// The posterior of a schema-1 model: every calibrated parameter gets the paper's prior of
+    /// R (centred on the nominal value, spread proportional to it) and is sampled as itself,
+    /// with zero density outside its support. Every record's forward model must calibrate the
+    /// same parameters.
     pub fn new(
         records: Vec<(ForwardModel, Observations)>,
+        settings: &ModelSettings,
+    ) -> Result<Self, String> {
+        let Some((first, _)) = records.first() else {
+            return Err("no recordings".into());
+        };
+        let theta = first
+            .calibrated_specs()
+            .iter()
+            .map(|spec| {
+                CalibratedParameter::untransformed(
+                    spec,
+                    settings.resistance_prior(spec.nominal.abs()),
+                )
+            })
+            .collect();
+        Self::with_parameters(records, theta, settings)
+    }
+
+    /// The posterior with each calibrated parameter's own prior and transform, in the order of
+    /// the forward models' calibrated parameters.
+    pub fn with_parameters(
+        records: Vec<(ForwardModel, Observations)>,
+        theta: Vec<CalibratedParameter>,
         settings: &ModelSettings,
     ) -> Result<Self, String> {
         settings.validate()?;
         let Some((first, _)) = records.first() else {
             return Err("no recordings".into());
         };
-        let theta_names: Vec<String> = first
-            .calibrated_names()
-            .iter()
-            .map(|s| s.to_string())
-            .collect();
-        let nominal = first.nominal_calibrated();
-        let mut theta_priors = Vec::new();
-        let mut theta_positive = Vec::new();
-        for (name, &value) in theta_names.iter().zip(&nominal) {
-            // Every calibrated motor parameter gets the paper's prior of R: centred on the
-            // nominal value, with a spread proportional to it.
-            theta_priors.push(settings.resistance_prior(value.abs()));
-            theta_positive.push(MotorParam::from_key(name).is_some_and(|p| p.must_be_positive()));
+        let calibrated = first.calibrated_names();
+        if calibrated.len() != theta.len()
+            || calibrated.iter().zip(&theta).any(|(a, b)| *a != b.name)
+        {
+            return Err(format!(
+                "the priors name {:?}, the model calibrates {calibrated:?}",
+                theta.iter().map(|t| t.name.as_str()).collect::<Vec<_>>()
+            ));
         }
+        let theta_names: Vec<String> = theta.iter().map(|t| t.coordinate_name()).collect();
         let noise_prior = Prior::InverseGamma {
             shape: settings.noise_prior_shape,
             scale: settings.noise_prior_scale,
@@ -173,13 +215,13 @@ impl CalibrationPosterior {
 
         let several = records.len() > 1;
         let mut names: Vec<String> = theta_names.clone();
-        let mut output_names: Vec<String> = theta_names.clone();
+        let mut output_names: Vec<String> = theta.iter().map(|t| t.output_name()).collect();
         let mut blocks: Vec<Range<usize>> = (0..theta_names.len()).map(|i| i..i + 1).collect();
         let mut next = theta_names.len();
         let mut terms = Vec::new();
         let mut pending_coefficients = Vec::new();
         for (r, (forward, obs)) in records.into_iter().enumerate() {
-            if forward.calibrated_names() != first_names(&theta_names) {
+            if forward.calibrated_names() != calibrated {
                 return Err(format!(
                     "recording '{}' calibrates other parameters than the first",
                     obs.label
@@ -222,9 +264,16 @@ impl CalibrationPosterior {
             }
             if let Some(k) = settings.discrepancy_degree {
                 let t_end = *forward.times().last().expect("times are non-empty");
-                let basis = Legendre::new(k, t_end)?;
+                let basis = settings.discrepancy_basis.build(k, t_end)?;
+                let b = basis.matrix(forward.times());
                 for c in 0..channels.len() {
-                    pending_coefficients.push((terms.len(), c, basis.clone(), suffix.clone()));
+                    pending_coefficients.push((
+                        terms.len(),
+                        c,
+                        b.clone(),
+                        basis.describe(),
+                        suffix.clone(),
+                    ));
                 }
             }
             let n_out = forward.n_outputs();
@@ -232,24 +281,17 @@ impl CalibrationPosterior {
             terms.push(RecordTerm {
                 label: obs.label,
                 channels,
-                cached: Cached::Nothing,
-                cached_theta: Vec::new(),
-                previous: Cached::Nothing,
-                previous_theta: Vec::new(),
-                previous_outputs: vec![0.0; n_out],
-                previous_jacobian: DMatrix::zeros(n_out, n_par),
-                outputs: vec![0.0; n_out],
-                jacobian: DMatrix::zeros(n_out, n_par),
+                current: Solve::empty(n_out, n_par),
+                previous: Solve::empty(n_out, n_par),
                 residual: vec![0.0; m],
                 forward,
             });
         }
         // Coefficients come last, after every σ, so that the small, well-identified
         // coordinates lead the parameter vector as in the paper's tables.
-        for (r, c, basis, suffix) in pending_coefficients {
+        for (r, c, b, description, suffix) in pending_coefficients {
             let term = &mut terms[r];
-            let n = basis.n_functions();
-            let b = basis.matrix(term.forward.times());
+            let n = b.ncols();
             let gram = b.transpose() * &b;
             let ch = &mut term.channels[c];
             for j in 0..n {
@@ -259,7 +301,7 @@ impl CalibrationPosterior {
             }
             blocks.push(next..next + n);
             ch.discrepancy = Some(Discrepancy {
-                description: basis.describe(),
+                description,
                 basis: b,
                 gram,
                 offset: next,
@@ -271,9 +313,9 @@ impl CalibrationPosterior {
         }
         Ok(Self {
             settings: settings.clone(),
+            theta_x: vec![0.0; theta.len()],
+            theta,
             theta_names,
-            theta_priors,
-            theta_positive,
             noise_prior,
             records: terms,
             dim: next,
@@ -291,8 +333,23 @@ impl CalibrationPosterior {
         self.theta_names.len()
     }
 
+    /// Names of the unconstrained coordinates of θ.
     pub fn theta_names(&self) -> &[String] {
         &self.theta_names
+    }
+
+    /// The calibrated parameters with their priors and transforms.
+    pub fn calibrated(&self) -> &[CalibratedParameter] {
+        &self.theta
+    }
+
+    /// θ in the model's own coordinates from the unconstrained point x.
+    pub fn theta_of(&self, x: &[f64]) -> Vec<f64> {
+        self.theta
+            .iter()
+            .zip(x)
+            .map(|(t, &u)| t.transform.map(u).x)
+            .collect()
     }
 
     /// Number of reported quantities (equal to the dimension: one per coordinate).
@@ -350,20 +407,22 @@ impl CalibrationPosterior {
 
     /// G(θ) of a record (channel-major), at the θ in x.
     pub fn simulate(&mut self, x: &[f64], record: usize) -> Result<Vec<f64>, DensityError> {
-        let p = self.n_theta();
+        let theta = self.theta_of(x);
         let term = &mut self.records[record];
-        term.ensure_forward(&x[..p], false)?;
-        Ok(term.outputs.clone())
+        term.ensure_forward(&theta, false)?;
+        Ok(term.current.outputs.clone())
     }
 
     /// A sensible start: nominal θ, the discrepancy that least-squares fits the nominal
     /// residual, and the noise level of what is left.
     pub fn initial_point(&mut self) -> Result<Vec<f64>, DensityError> {
         let mut x = vec![0.0; self.dim];
-        let p = self.n_theta();
-        x[..p].copy_from_slice(&self.records[0].forward.nominal_calibrated());
+        let theta: Vec<f64> = self.theta.iter().map(|t| t.start).collect();
+        for (k, t) in self.theta.iter().enumerate() {
+            x[k] = t.to_unconstrained(theta[k]);
+        }
         for term in &mut self.records {
-            term.ensure_forward(&x[..p], false)?;
+            term.ensure_forward(&theta, false)?;
             for c in 0..term.channels.len() {
                 term.residual(c, &x);
                 if let Some(d) = &term.channels[c].discrepancy {
@@ -393,6 +452,18 @@ impl CalibrationPosterior {
         Ok(x)
     }
 
+    /// The priors of θ at the point's u, with θ itself written to `theta_x`; `None` where the
+    /// density is zero.
+    fn theta_priors(&mut self, x: &[f64]) -> Option<Vec<PriorInU>> {
+        let mut out = Vec::with_capacity(self.theta.len());
+        for (k, t) in self.theta.iter().enumerate() {
+            let at = t.at(x[k])?;
+            self.theta_x[k] = at.x;
+            out.push(at);
+        }
+        Some(out)
+    }
+
     fn evaluate(&mut self, x: &[f64], mut grad: Option<&mut [f64]>) -> Result<f64, DensityError> {
         if x.len() != self.dim {
             return Err(DensityError::fatal(format!(
@@ -405,23 +476,21 @@ impl CalibrationPosterior {
             g.fill(0.0);
         }
         let p = self.n_theta();
-        let theta = &x[..p];
         if x.iter().any(|v| !v.is_finite()) {
             return Ok(f64::NEG_INFINITY);
         }
-        for (k, &v) in theta.iter().enumerate() {
-            if self.theta_positive[k] && v <= 0.0 {
-                return Ok(f64::NEG_INFINITY);
-            }
-        }
+        let Some(priors) = self.theta_priors(x) else {
+            return Ok(f64::NEG_INFINITY);
+        };
         let mut lp = 0.0;
-        for (k, &v) in theta.iter().enumerate() {
-            lp += self.theta_priors[k].log_density(v);
+        for (k, at) in priors.iter().enumerate() {
+            lp += at.log_density;
             if let Some(g) = grad.as_deref_mut() {
-                g[k] += self.theta_priors[k].gradient(v);
+                g[k] += at.gradient;
             }
         }
         let need_sensitivities = grad.is_some();
+        let theta = &self.theta_x;
         for term in &mut self.records {
             term.ensure_forward(theta, need_sensitivities)?;
             let m = term.forward.n_samples();
@@ -439,8 +508,8 @@ impl CalibrationPosterior {
                     g[ch.log_sigma_index] +=
                         -(m as f64) + ss * inv_var + self.noise_prior.gradient(sigma) * sigma + 1.0;
                     for k in 0..p {
-                        let sens = column_rows(&term.jacobian, k, c * m..(c + 1) * m);
-                        g[k] += inv_var * dot(sens, &term.residual);
+                        g[k] +=
+                            inv_var * dot(term.sensitivities(k, c), &term.residual) * priors[k].dx;
                     }
                 }
                 if let Some(d) = &ch.discrepancy {
@@ -458,10 +527,6 @@ impl CalibrationPosterior {
         }
         Ok(lp)
     }
-}
-
-fn first_names(names: &[String]) -> Vec<&str> {
-    names.iter().map(|s| s.as_str()).collect()
 }
 
 /// Rows `rows` of column `k` of a column-major matrix, as a slice.
@@ -502,6 +567,9 @@ impl LogDensity for CalibrationPosterior {
     fn constrain(&self, x: &[f64], out: &mut Vec<f64>) {
         out.clear();
         out.extend_from_slice(x);
+        for (k, t) in self.theta.iter().enumerate() {
+            out[k] = t.transform.map(x[k]).x;
+        }
         for term in &self.records {
             for ch in &term.channels {
                 out[ch.log_sigma_index] = x[ch.log_sigma_index].exp();
@@ -515,20 +583,24 @@ impl LogDensity for CalibrationPosterior {
 }
 
 impl FisherMetric for CalibrationPosterior {
-    /// Σ_c σ_c⁻² [J_c B_c]ᵀ[J_c B_c] in (θ, a_c), 2·M_c for each log σ_c, plus the priors'
-    /// curvature (zero for Laplace coefficients: their kink is not a curvature).
+    /// Σ_c σ_c⁻² [J_c B_c]ᵀ[J_c B_c] in (u(θ), a_c), with J_c carried to u by dθ/du, 2·M_c for
+    /// each log σ_c, plus the priors' curvature (zero for Laplace coefficients: their kink is
+    /// not a curvature).
     fn fisher_metric(&mut self, x: &[f64], metric: &mut DMatrix<f64>) -> Result<(), DensityError> {
         let p = self.n_theta();
         metric.fill(0.0);
-        let theta = &x[..p];
-        for (k, &v) in theta.iter().enumerate() {
-            metric[(k, k)] += self.theta_priors[k].curvature(v);
+        let priors = self.theta_priors(x).ok_or_else(|| {
+            DensityError::recoverable("the metric is undefined outside the support")
+        })?;
+        for (k, at) in priors.iter().enumerate() {
+            metric[(k, k)] += at.metric;
         }
+        let theta = &self.theta_x;
         for term in &mut self.records {
             term.ensure_forward(theta, true)?;
-            let m = term.forward.n_samples();
             for ch_index in 0..term.channels.len() {
                 let ch = &term.channels[ch_index];
+                let m = ch.observed.len();
                 let s = x[ch.log_sigma_index];
                 let inv_var = (-2.0 * s).exp();
                 let sigma = s.exp();
@@ -538,12 +610,11 @@ impl FisherMetric for CalibrationPosterior {
                     _ => 0.0,
                 };
                 metric[(ch.log_sigma_index, ch.log_sigma_index)] += 2.0 * m as f64 + prior_curv;
-                let rows = ch_index * m..(ch_index + 1) * m;
                 for k in 0..p {
-                    let jk = column_rows(&term.jacobian, k, rows.clone());
+                    let jk = term.sensitivities(k, ch_index);
                     for l in 0..=k {
-                        let jl = column_rows(&term.jacobian, l, rows.clone());
-                        let v = inv_var * dot(jk, jl);
+                        let jl = term.sensitivities(l, ch_index);
+                        let v = inv_var * dot(jk, jl) * priors[k].dx * priors[l].dx;
                         metric[(k, l)] += v;
                         if l != k {
                             metric[(l, k)] += v;
@@ -555,8 +626,8 @@ impl FisherMetric for CalibrationPosterior {
                     for j in 0..n {
                         let bj = d.basis.column(j);
                         for k in 0..p {
-                            let jk = column_rows(&term.jacobian, k, rows.clone());
-                            let v = inv_var * dot(jk, bj.as_slice());
+                            let jk = term.sensitivities(k, ch_index);
+                            let v = inv_var * dot(jk, bj.as_slice()) * priors[k].dx;
                             metric[(k, d.offset + j)] += v;
                             metric[(d.offset + j, k)] += v;
                         }
@@ -573,9 +644,10 @@ impl FisherMetric for CalibrationPosterior {
     }
 
     /// The metric with the noise-scale rows made exact: −∂²log π/∂s² = 2·SS/σ² (not its
-    /// expectation 2M) and the couplings 2Jᵀr/σ², 2Bᵀr/σ² of log σ with θ and a. At the mode
-    /// Bᵀr/σ² equals the Laplace prior's pull ±1/b, which the weakly identified R–δ direction
-    /// feels; the residual curvature of G in θ is still left out.
+    /// expectation 2M) and the couplings 2Jᵀr/σ², 2Bᵀr/σ² of log σ with θ and a; for a
+    /// transformed θ_k also the exact prior curvature in u and the likelihood's pull times
+    /// d²θ/du². At the mode Bᵀr/σ² equals the Laplace prior's pull ±1/b, which the weakly
+    /// identified R–δ direction feels; the residual curvature of G in θ is still left out.
     fn observed_information(
         &mut self,
         x: &[f64],
@@ -583,22 +655,23 @@ impl FisherMetric for CalibrationPosterior {
     ) -> Result<(), DensityError> {
         self.fisher_metric(x, out)?;
         let p = self.n_theta();
+        let priors = self.theta_priors(x).ok_or_else(|| {
+            DensityError::recoverable("the information is undefined outside the support")
+        })?;
+        let mut pull = vec![0.0; p];
         for term in &mut self.records {
-            let m = term.forward.n_samples();
             for c in 0..term.channels.len() {
                 term.residual(c, x);
                 let ch = &term.channels[c];
+                let m = ch.observed.len();
                 let si = ch.log_sigma_index;
                 let inv_var = (-2.0 * x[si]).exp();
                 let ss: f64 = term.residual.iter().map(|r| r * r).sum();
                 out[(si, si)] += 2.0 * ss * inv_var - 2.0 * m as f64;
                 for k in 0..p {
-                    let v = 2.0
-                        * inv_var
-                        * dot(
-                            column_rows(&term.jacobian, k, c * m..(c + 1) * m),
-                            &term.residual,
-                        );
+                    let jr = dot(term.sensitivities(k, c), &term.residual);
+                    pull[k] += inv_var * jr;
+                    let v = 2.0 * inv_var * jr * priors[k].dx;
                     out[(si, k)] += v;
                     out[(k, si)] += v;
                 }
@@ -609,6 +682,11 @@ impl FisherMetric for CalibrationPosterior {
                         out[(d.offset + j, si)] += v;
                     }
                 }
+            }
+        }
+        for (k, t) in self.theta.iter().enumerate() {
+            if t.transform != Transform::Identity {
+                out[(k, k)] += priors[k].curvature - priors[k].metric - pull[k] * priors[k].d2x;
             }
         }
         Ok(())

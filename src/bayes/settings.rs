@@ -61,11 +61,46 @@ impl CoefficientPrior {
     }
 }
 
+/// The family of functions δ is expanded in.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BasisKind {
+    /// Orthonormal Legendre polynomials on [0, T] (the paper's choice).
+    #[default]
+    Legendre,
+}
+
+impl BasisKind {
+    /// The basis of degree K on a recording ending at `t_end`.
+    pub fn build(
+        &self,
+        degree: usize,
+        t_end: f64,
+    ) -> Result<Box<dyn super::DiscrepancyBasis>, String> {
+        match self {
+            BasisKind::Legendre => Ok(Box::new(super::Legendre::new(degree, t_end)?)),
+        }
+    }
+
+    pub fn max_degree(&self) -> usize {
+        match self {
+            BasisKind::Legendre => super::basis::MAX_LEGENDRE_DEGREE,
+        }
+    }
+
+    pub fn name(&self) -> &'static str {
+        match self {
+            BasisKind::Legendre => "legendre",
+        }
+    }
+}
+
 /// BM1 (`discrepancy_degree = None`) or BM2(K) with its priors.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct ModelSettings {
     pub discrepancy_degree: Option<usize>,
+    pub discrepancy_basis: BasisKind,
     /// The prior of R is N(R_nominal, spread·R_nominal) in the reading below.
     pub resistance_prior_spread: f64,
     pub resistance_prior_reading: SpreadReading,
@@ -79,6 +114,7 @@ impl Default for ModelSettings {
     fn default() -> Self {
         Self {
             discrepancy_degree: Some(9),
+            discrepancy_basis: BasisKind::Legendre,
             resistance_prior_spread: 0.2,
             resistance_prior_reading: SpreadReading::StandardDeviation,
             coefficient_prior: CoefficientPrior::default(),
@@ -112,11 +148,12 @@ impl ModelSettings {
 
     pub fn validate(&self) -> Result<(), String> {
         if let Some(k) = self.discrepancy_degree
-            && k > super::basis::MAX_LEGENDRE_DEGREE
+            && k > self.discrepancy_basis.max_degree()
         {
             return Err(format!(
-                "discrepancy degree K = {k} is larger than the maximum {}",
-                super::basis::MAX_LEGENDRE_DEGREE
+                "discrepancy degree K = {k} is larger than the maximum {} of the {} basis",
+                self.discrepancy_basis.max_degree(),
+                self.discrepancy_basis.name()
             ));
         }
         let positive = [

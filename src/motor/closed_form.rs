@@ -7,10 +7,12 @@ use num_dual::DualNum;
 
 use super::MotorParam;
 
-/// (I(t), ω(t)) for constant U from the parameter vector `p` (ordered as [`MotorParam::ALL`]),
-/// or `None` when A has complex or repeated eigenvalues.
+/// (I(t), ω(t)) for constant U from the base parameter vector `p` (ordered as
+/// [`MotorParam::ALL`]) and a constant load torque, or `None` when A has complex or repeated
+/// eigenvalues.
 pub fn constant_voltage_solution<D: DualNum<Primitive = f64> + Copy>(
     p: &[D],
+    load_torque: D,
     t: f64,
 ) -> Option<[D; 2]> {
     use MotorParam::*;
@@ -20,7 +22,7 @@ pub fn constant_voltage_solution<D: DualNum<Primitive = f64> + Copy>(
         [-g(Resistance) / l, -g(BackEmfConstant) / l],
         [g(TorqueConstant) / j, -g(ViscousFriction) / j],
     ];
-    let b = [g(Voltage) / l, -g(LoadTorque) / j];
+    let b = [g(Voltage) / l, -load_torque / j];
     let x0 = [g(InitialCurrent), g(InitialSpeed)];
     let trace = a[0][0] + a[1][1];
     let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];

@@ -1,40 +1,171 @@
-//! The DC motor of §2 of the paper: its parameters, its input voltage, and the right-hand side of
-//! equations (3)–(4) written once, generic over the number type so that the same code gives values
-//! (`f64`) and forward sensitivities (num-dual numbers).
+//! The model a user believes: a base model (the voltage-driven DC motor of §2 of the paper) plus
+//! a list of active physics terms, with the right-hand side written once, generic over the
+//! number type, so that the same code gives values (`f64`) and forward sensitivities
+//! (num-dual numbers).
 //!
-//! The model is data: a parameter vector with names, a state vector, channels it measures. Physics
-//! terms that the missing-physics diagnosis adds later append parameters and states to these
-//! vectors instead of copying the motor.
+//! The model is data: a parameter vector (the base's parameters, then each term's), a state
+//! vector (the base's states, then each term's), and the channels it measures. A term is an
+//! addition to these vectors, never a copy of the motor.
 
 pub mod closed_form;
 mod input;
 mod parameters;
+pub mod terms;
 
 pub use input::VoltageInput;
 pub use parameters::{MotorParam, MotorParameters};
+pub use terms::{Balance, Coefficients, Magnitudes, PRIOR_SHARE, Site, Term};
 
 use num_dual::DualNum;
 
 use crate::ode::OdeSystem;
+use crate::parameter::{ParameterSpec, Prior, Support};
+
+/// The number types the physics is written for: `f64` and num-dual's dual numbers.
+pub trait Scalar: DualNum<Primitive = f64> + Copy {}
+impl<D: DualNum<Primitive = f64> + Copy> Scalar for D {}
 
 /// The channels the motor's measurement map produces, in output order.
 pub const MOTOR_CHANNELS: [&str; 2] = ["I", "omega"];
 
-/// A motor model: nominal parameters and the input it is driven with.
-#[derive(Clone, Debug)]
-pub struct MotorModel {
-    pub nominal: MotorParameters,
-    pub input: VoltageInput,
+/// The physics the terms are added to. One kind today; force- or current-driven mechanics and
+/// closed loops are further kinds with their own parameters, states and channels.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Base {
+    /// L dI/dt = U − R I − c_m ω, J dω/dt = c_g I − d ω, measuring I and ω (eqs. 3–4).
+    #[default]
+    VoltageDriven,
 }
 
-impl MotorModel {
-    pub fn new(nominal: MotorParameters, input: VoltageInput) -> Self {
-        Self { nominal, input }
+impl Base {
+    pub fn name(&self) -> &'static str {
+        match self {
+            Base::VoltageDriven => "voltage_driven",
+        }
     }
 
-    /// Names of the model's parameter vector, in the order of [`MotorModel::parameter_values`].
-    pub fn parameter_names(&self) -> Vec<&'static str> {
-        MotorParam::ALL.iter().map(|p| p.key()).collect()
+    pub fn state_names(&self) -> &'static [&'static str] {
+        match self {
+            Base::VoltageDriven => &MOTOR_CHANNELS,
+        }
+    }
+
+    pub fn channels(&self) -> &'static [&'static str] {
+        match self {
+            Base::VoltageDriven => &MOTOR_CHANNELS,
+        }
+    }
+}
+
+/// A term switched on, with the nominal values of its parameters.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ActiveTerm {
+    pub term: Term,
+    pub values: Vec<f64>,
+}
+
+impl ActiveTerm {
+    /// The term at its parameters' default values (absent effects).
+    pub fn with_defaults(term: Term) -> Self {
+        let values = term.params().iter().map(|p| p.default).collect();
+        Self { term, values }
+    }
+}
+
+/// A model: base, nominal values, the input it is driven with, and its active terms in
+/// [`Term::NAMES`] order (so that the parameter vector does not depend on the order of a file).
+#[derive(Clone, Debug, PartialEq)]
+pub struct MotorModel {
+    pub base: Base,
+    pub nominal: MotorParameters,
+    pub input: VoltageInput,
+    terms: Vec<ActiveTerm>,
+    /// Offsets of each term's parameters in the parameter vector (one more than terms).
+    param_offsets: Vec<usize>,
+    /// Offsets of each term's states in the state vector (one more than terms).
+    state_offsets: Vec<usize>,
+}
+
+const N_BASE_PARAMS: usize = MotorParam::ALL.len();
+
+impl MotorModel {
+    /// The plain motor; a schema-1 load torque T_L ≠ 0 becomes the `load_torque` term.
+    pub fn new(nominal: MotorParameters, input: VoltageInput) -> Self {
+        Self::with_terms(nominal, input, Vec::new()).expect("no terms cannot collide")
+    }
+
+    pub fn with_terms(
+        nominal: MotorParameters,
+        input: VoltageInput,
+        mut terms: Vec<ActiveTerm>,
+    ) -> Result<Self, String> {
+        if nominal.load_torque != 0.0 {
+            if terms.iter().any(|t| matches!(t.term, Term::LoadTorque(_))) {
+                return Err(
+                    "the load torque is given twice: as motor.T_L and as the load_torque term"
+                        .into(),
+                );
+            }
+            terms.push(ActiveTerm {
+                term: Term::LoadTorque(terms::LoadTorque),
+                values: vec![nominal.load_torque],
+            });
+        }
+        terms.sort_by_key(|t| t.term.rank());
+        for pair in terms.windows(2) {
+            if pair[0].term.name() == pair[1].term.name() {
+                return Err(format!("term {} is listed twice", pair[0].term.name()));
+            }
+        }
+        for t in &terms {
+            if t.values.len() != t.term.params().len() {
+                return Err(format!(
+                    "term {} takes {} parameter values, got {}",
+                    t.term.name(),
+                    t.term.params().len(),
+                    t.values.len()
+                ));
+            }
+            if let Some(v) = t.values.iter().find(|v| !v.is_finite()) {
+                return Err(format!("term {}: value {v} is not finite", t.term.name()));
+            }
+        }
+        let base = Base::VoltageDriven;
+        let mut param_offsets = vec![N_BASE_PARAMS];
+        let mut state_offsets = vec![base.state_names().len()];
+        for t in &terms {
+            param_offsets.push(param_offsets.last().unwrap() + t.term.params().len());
+            state_offsets.push(state_offsets.last().unwrap() + t.term.states().len());
+        }
+        Ok(Self {
+            base,
+            nominal: MotorParameters {
+                load_torque: 0.0,
+                ..nominal
+            },
+            input,
+            terms,
+            param_offsets,
+            state_offsets,
+        })
+    }
+
+    pub fn terms(&self) -> &[ActiveTerm] {
+        &self.terms
+    }
+
+    /// Names of the parameter vector: the base's keys, then `term.key` for each term's.
+    pub fn parameter_names(&self) -> Vec<String> {
+        MotorParam::ALL
+            .iter()
+            .map(|p| p.key().to_string())
+            .chain(self.terms.iter().flat_map(|t| {
+                t.term
+                    .params()
+                    .iter()
+                    .map(move |p| format!("{}.{}", t.term.name(), p.key))
+            }))
+            .collect()
     }
 
     /// The nominal values of the full parameter vector.
@@ -42,65 +173,131 @@ impl MotorModel {
         MotorParam::ALL
             .iter()
             .map(|&p| self.nominal.get(p))
+            .chain(self.terms.iter().flat_map(|t| t.values.iter().copied()))
             .collect()
     }
 
     pub fn parameter_index(&self, name: &str) -> Option<usize> {
-        MotorParam::ALL.iter().position(|p| p.key() == name)
+        self.parameter_names().iter().position(|n| n == name)
+    }
+
+    /// The scales the default priors are drawn to, for a recording of the given length.
+    pub fn magnitudes(&self, duration: f64) -> Magnitudes {
+        let m = &self.nominal;
+        let held_max = match &self.input {
+            VoltageInput::Constant => m.voltage.abs(),
+            VoltageInput::Held { values, .. } => values.iter().fold(0.0f64, |a, v| a.max(v.abs())),
+        };
+        // A degenerate nominal model (U = 0, c_m = 0) would give zero or infinite scales; one
+        // unit is then as good a scale as any, and finite.
+        let sane = |v: f64| if v.is_finite() && v > 0.0 { v } else { 1.0 };
+        let voltage = sane(held_max);
+        let current = sane(voltage / m.resistance);
+        let speed = sane(voltage / m.back_emf_constant);
+        let torque = sane(m.torque_constant * current);
+        let time_constant =
+            sane(m.inertia * m.resistance / (m.torque_constant * m.back_emf_constant));
+        Magnitudes {
+            voltage,
+            current,
+            speed,
+            torque,
+            energy: sane(voltage * voltage / m.resistance * time_constant),
+            duration: sane(duration),
+        }
+    }
+
+    /// Every parameter with its unit, support and default prior (scaled by `magnitudes`).
+    pub fn parameter_specs(&self, magnitudes: &Magnitudes) -> Vec<ParameterSpec> {
+        let mut specs: Vec<ParameterSpec> = MotorParam::ALL
+            .iter()
+            .map(|&p| base_spec(p, self.nominal.get(p), magnitudes))
+            .collect();
+        for t in &self.terms {
+            for (decl, &value) in t.term.params().iter().zip(&t.values) {
+                specs.push(ParameterSpec {
+                    name: format!("{}.{}", t.term.name(), decl.key),
+                    unit: decl.unit,
+                    nominal: value,
+                    support: (decl.support)(magnitudes),
+                    default_prior: (decl.prior)(magnitudes),
+                });
+            }
+        }
+        specs
+    }
+
+    /// Why a parameter cannot be calibrated, if it cannot (e.g. the time of a hard step).
+    pub fn check_calibrated(&self, name: &str) -> Result<(), String> {
+        let Some((term_name, key)) = name.split_once('.') else {
+            return Ok(());
+        };
+        match self.terms.iter().find(|t| t.term.name() == term_name) {
+            Some(t) => t.term.check_calibrated(key),
+            None => Ok(()),
+        }
     }
 
     pub fn n_states(&self) -> usize {
-        2
+        *self.state_offsets.last().expect("offsets are never empty")
     }
 
     pub fn channels(&self) -> &'static [&'static str] {
-        &MOTOR_CHANNELS
+        self.base.channels()
     }
 
-    /// Times at which the right-hand side jumps: where a held input changes its value.
+    /// Times at which the right-hand side jumps: where a held input changes its value, and
+    /// where a term switches hard.
     pub fn breakpoints(&self) -> Vec<f64> {
-        self.input.breakpoints()
+        let mut points = self.input.breakpoints();
+        if !self.terms.is_empty() {
+            for t in &self.terms {
+                points.extend(t.term.breakpoints(&t.values));
+            }
+            points.sort_by(f64::total_cmp);
+            points.dedup();
+        }
+        points
     }
 
-    pub fn initial_state<D: DualNum<Primitive = f64> + Copy>(&self, p: &[D], y0: &mut [D]) {
+    pub fn initial_state<D: Scalar>(&self, p: &[D], y0: &mut [D]) {
         y0[0] = p[MotorParam::InitialCurrent as usize];
         y0[1] = p[MotorParam::InitialSpeed as usize];
+        for (k, t) in self.terms.iter().enumerate() {
+            for (j, s) in t.term.states().iter().enumerate() {
+                y0[self.state_offsets[k] + j] = D::from(s.initial);
+            }
+        }
     }
 
-    /// Equations (3)–(4): L dI/dt = −R I − c_m ω + U and J dω/dt = c_g I − d ω − T_L, with the load
-    /// torque opposing motion (the paper writes +T_L but only ever uses T_L = 0).
-    #[inline]
-    pub fn rhs<D: DualNum<Primitive = f64> + Copy>(
-        &self,
-        voltage: D,
-        y: &[D],
-        c: &Coefficients<D>,
-        dy: &mut [D],
-    ) {
-        let (current, speed) = (y[0], y[1]);
-        let electrical = voltage - c.resistance * current - c.back_emf_constant * speed;
-        let mechanical = c.torque_constant * current - c.viscous_friction * speed - c.load_torque;
-        dy[0] = electrical * c.inverse_inductance;
-        dy[1] = mechanical * c.inverse_inertia;
-    }
-
-    /// The measurement map from states to channels (identity on I and ω for the plain motor).
-    pub fn measure<D: DualNum<Primitive = f64> + Copy>(&self, y: &[D], _p: &[D], out: &mut [D]) {
+    /// The measurement map from states to channels: I and ω, as the sensor terms amend them.
+    pub fn measure<D: Scalar>(&self, y: &[D], p: &[D], out: &mut [D]) {
         out[0] = y[0];
         out[1] = y[1];
+        for (k, t) in self.terms.iter().enumerate() {
+            t.term
+                .measure(&p[self.param_offsets[k]..self.param_offsets[k + 1]], out);
+        }
     }
 
     /// The ODE system at one parameter vector, ready for the integrator. `segments` is
     /// [`MotorModel::segments`], computed once per recording.
-    pub fn system<'a, D: DualNum<Primitive = f64> + Copy>(
+    pub fn system<'a, D: Scalar>(
         &'a self,
         p: &'a [D],
         segments: &'a Segments,
     ) -> MotorSystem<'a, D> {
+        let mut coefficients = base_coefficients(p);
+        for (k, t) in self.terms.iter().enumerate() {
+            t.term.adjust(
+                &p[self.param_offsets[k]..self.param_offsets[k + 1]],
+                &mut coefficients,
+            );
+        }
         MotorSystem {
             model: self,
             p,
-            coefficients: Coefficients::new(p),
+            coefficients,
             segments,
         }
     }
@@ -116,49 +313,77 @@ impl MotorModel {
                 .collect(),
         };
         Segments {
+            start: t0,
             breakpoints,
             voltage,
         }
     }
 }
 
+/// The base parameters' supports and default priors: R keeps the paper's N(R₀, 0.2R₀); the
+/// other positive constants a log-normal of 20% around their nominal value; signed quantities
+/// a normal of a tenth of the scale they act on.
+fn base_spec(p: MotorParam, nominal: f64, m: &Magnitudes) -> ParameterSpec {
+    use MotorParam::*;
+    let normal = |sd: f64| Prior::Normal { mean: nominal, sd };
+    let (support, default_prior) = match p {
+        Resistance => (Support::Positive, normal(0.2 * nominal)),
+        BackEmfConstant | TorqueConstant | Inductance | Inertia => (
+            Support::Positive,
+            Prior::LogNormal {
+                median: nominal,
+                sigma: 0.2,
+            },
+        ),
+        ViscousFriction if nominal > 0.0 => (
+            Support::Positive,
+            Prior::LogNormal {
+                median: nominal,
+                sigma: 0.2,
+            },
+        ),
+        ViscousFriction => (
+            Support::Positive,
+            Prior::HalfNormal {
+                scale: PRIOR_SHARE * m.torque / m.speed,
+            },
+        ),
+        Voltage => (Support::Real, normal(PRIOR_SHARE * m.voltage)),
+        InitialCurrent => (Support::Real, normal(PRIOR_SHARE * m.current)),
+        InitialSpeed => (Support::Real, normal(PRIOR_SHARE * m.speed)),
+    };
+    ParameterSpec {
+        name: p.key().to_string(),
+        unit: p.unit(),
+        nominal,
+        support,
+        default_prior,
+    }
+}
+
+fn base_coefficients<D: Scalar>(p: &[D]) -> Coefficients<D> {
+    use MotorParam::*;
+    Coefficients {
+        resistance: p[Resistance as usize],
+        back_emf_constant: p[BackEmfConstant as usize],
+        torque_constant: p[TorqueConstant as usize],
+        viscous_friction: p[ViscousFriction as usize],
+        inverse_inductance: p[Inductance as usize].recip(),
+        inverse_inertia: p[Inertia as usize].recip(),
+    }
+}
+
 /// The intervals between the right-hand side's discontinuities, and what is held on each.
 #[derive(Clone, Debug, Default)]
 pub struct Segments {
+    /// Where the integration starts.
+    pub start: f64,
     pub breakpoints: Vec<f64>,
     /// The held voltage on each interval; empty when the voltage is the constant parameter `U`.
     pub voltage: Vec<f64>,
 }
 
-/// The parameters as the right-hand side uses them, extracted once per solve: the divisions
-/// by L and J become multiplications, which matters when they run six times a step.
-#[derive(Clone, Copy, Debug)]
-pub struct Coefficients<D> {
-    pub resistance: D,
-    pub back_emf_constant: D,
-    pub torque_constant: D,
-    pub viscous_friction: D,
-    pub load_torque: D,
-    pub inverse_inductance: D,
-    pub inverse_inertia: D,
-}
-
-impl<D: DualNum<Primitive = f64> + Copy> Coefficients<D> {
-    pub fn new(p: &[D]) -> Self {
-        use MotorParam::*;
-        Self {
-            resistance: p[Resistance as usize],
-            back_emf_constant: p[BackEmfConstant as usize],
-            torque_constant: p[TorqueConstant as usize],
-            viscous_friction: p[ViscousFriction as usize],
-            load_torque: p[LoadTorque as usize],
-            inverse_inductance: p[Inductance as usize].recip(),
-            inverse_inertia: p[Inertia as usize].recip(),
-        }
-    }
-}
-
-/// A motor at fixed parameters: what the integrator sees.
+/// A model at fixed parameters: what the integrator sees.
 pub struct MotorSystem<'a, D> {
     model: &'a MotorModel,
     p: &'a [D],
@@ -166,7 +391,52 @@ pub struct MotorSystem<'a, D> {
     segments: &'a Segments,
 }
 
-impl<D: DualNum<Primitive = f64> + Copy> OdeSystem<D> for MotorSystem<'_, D> {
+impl<D: Scalar> MotorSystem<'_, D> {
+    /// Equations (3)–(4) with every term's contribution: L dI/dt = U − R I − c_m ω + Σ voltage
+    /// and J dω/dt = c_g I − d ω + Σ torque (the load torque opposes motion; the paper writes
+    /// +T_L but only ever uses T_L = 0).
+    #[inline]
+    fn with_terms(&self, t: f64, segment: usize, voltage: D, y: &[D], dy: &mut [D]) {
+        let model = self.model;
+        let c = &self.coefficients;
+        let (current, speed) = (y[0], y[1]);
+        let segment_start = match segment {
+            0 => self.segments.start,
+            s => self.segments.breakpoints[s - 1],
+        };
+        let site = |k: usize| Site {
+            t,
+            segment_start,
+            current,
+            speed,
+            params: &self.p[model.param_offsets[k]..model.param_offsets[k + 1]],
+            states: &y[model.state_offsets[k]..model.state_offsets[k + 1]],
+        };
+        let mut balance = Balance {
+            resistance: c.resistance,
+            torque_constant: c.torque_constant,
+            voltage: D::from(0.0),
+            torque: D::from(0.0),
+        };
+        for (k, active) in model.terms.iter().enumerate() {
+            active.term.contribute(&site(k), &mut balance);
+        }
+        let electrical =
+            voltage - balance.resistance * current - c.back_emf_constant * speed + balance.voltage;
+        let mechanical =
+            balance.torque_constant * current - c.viscous_friction * speed + balance.torque;
+        dy[0] = electrical * c.inverse_inductance;
+        dy[1] = mechanical * c.inverse_inertia;
+        for (k, active) in model.terms.iter().enumerate() {
+            let states = model.state_offsets[k]..model.state_offsets[k + 1];
+            if !states.is_empty() {
+                active.term.derivatives(&site(k), &balance, &mut dy[states]);
+            }
+        }
+    }
+}
+
+impl<D: Scalar> OdeSystem<D> for MotorSystem<'_, D> {
     fn n_states(&self) -> usize {
         self.model.n_states()
     }
@@ -176,13 +446,22 @@ impl<D: DualNum<Primitive = f64> + Copy> OdeSystem<D> for MotorSystem<'_, D> {
     }
 
     #[inline]
-    fn rhs(&self, _t: f64, segment: usize, y: &[D], dy: &mut [D]) {
+    fn rhs(&self, t: f64, segment: usize, y: &[D], dy: &mut [D]) {
         // The held value of the interval being integrated, not the value at t: a step that ends
         // exactly on a breakpoint must still see the old voltage in its last stage.
         let voltage = match self.segments.voltage.get(segment) {
             Some(&u) => D::from(u),
             None => self.p[MotorParam::Voltage as usize],
         };
-        self.model.rhs(voltage, y, &self.coefficients, dy);
+        if !self.model.terms.is_empty() {
+            return self.with_terms(t, segment, voltage, y, dy);
+        }
+        // The paper's motor alone, as a straight line of arithmetic: this runs six times a step.
+        let c = &self.coefficients;
+        let (current, speed) = (y[0], y[1]);
+        let electrical = voltage - c.resistance * current - c.back_emf_constant * speed;
+        let mechanical = c.torque_constant * current - c.viscous_friction * speed;
+        dy[0] = electrical * c.inverse_inductance;
+        dy[1] = mechanical * c.inverse_inertia;
     }
 }

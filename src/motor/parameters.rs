@@ -12,13 +12,12 @@ pub enum MotorParam {
     ViscousFriction,
     Inductance,
     Inertia,
-    LoadTorque,
     InitialCurrent,
     InitialSpeed,
 }
 
 impl MotorParam {
-    pub const ALL: [MotorParam; 10] = [
+    pub const ALL: [MotorParam; 9] = [
         MotorParam::Resistance,
         MotorParam::BackEmfConstant,
         MotorParam::TorqueConstant,
@@ -26,7 +25,6 @@ impl MotorParam {
         MotorParam::ViscousFriction,
         MotorParam::Inductance,
         MotorParam::Inertia,
-        MotorParam::LoadTorque,
         MotorParam::InitialCurrent,
         MotorParam::InitialSpeed,
     ];
@@ -41,9 +39,22 @@ impl MotorParam {
             MotorParam::ViscousFriction => "d",
             MotorParam::Inductance => "L",
             MotorParam::Inertia => "J",
-            MotorParam::LoadTorque => "T_L",
             MotorParam::InitialCurrent => "I0",
             MotorParam::InitialSpeed => "omega0",
+        }
+    }
+
+    pub fn unit(self) -> &'static str {
+        match self {
+            MotorParam::Resistance => "Ω",
+            MotorParam::BackEmfConstant => "V·s/rad",
+            MotorParam::TorqueConstant => "N·m/A",
+            MotorParam::Voltage => "V",
+            MotorParam::ViscousFriction => "N·m·s/rad",
+            MotorParam::Inductance => "H",
+            MotorParam::Inertia => "kg·m²",
+            MotorParam::InitialCurrent => "A",
+            MotorParam::InitialSpeed => "rad/s",
         }
     }
 
@@ -85,7 +96,8 @@ pub struct MotorParameters {
     /// Rotor inertia J [kg·m²].
     #[serde(rename = "J")]
     pub inertia: f64,
-    /// Constant load torque T_L [N·m], opposing motion.
+    /// Constant load torque T_L [N·m], opposing motion: the key of schema-1 files, read as the
+    /// `load_torque` term's T_0 (not a parameter of the base model).
     #[serde(rename = "T_L")]
     pub load_torque: f64,
     /// Initial current I(0) [A].
@@ -133,7 +145,6 @@ impl MotorParameters {
             MotorParam::ViscousFriction => self.viscous_friction,
             MotorParam::Inductance => self.inductance,
             MotorParam::Inertia => self.inertia,
-            MotorParam::LoadTorque => self.load_torque,
             MotorParam::InitialCurrent => self.initial_current,
             MotorParam::InitialSpeed => self.initial_speed,
         }
@@ -148,7 +159,6 @@ impl MotorParameters {
             MotorParam::ViscousFriction => &mut self.viscous_friction,
             MotorParam::Inductance => &mut self.inductance,
             MotorParam::Inertia => &mut self.inertia,
-            MotorParam::LoadTorque => &mut self.load_torque,
             MotorParam::InitialCurrent => &mut self.initial_current,
             MotorParam::InitialSpeed => &mut self.initial_speed,
         };
@@ -157,6 +167,9 @@ impl MotorParameters {
 
     /// Physical plausibility: every value finite, R, L and J positive.
     pub fn validate(&self) -> Result<(), String> {
+        if !self.load_torque.is_finite() {
+            return Err(format!("T_L = {} is not a finite number", self.load_torque));
+        }
         for p in MotorParam::ALL {
             let v = self.get(p);
             if !v.is_finite() {

@@ -1,0 +1,291 @@
+//! Physics terms: pieces a model can switch on, each adding parameters (with support and a
+//! default prior scaled by the model's own magnitudes), perhaps states, and a contribution to the
+//! electrical equation, the mechanical equation or the measurement map.
+//!
+//! Every term is one file of the same shape: a struct holding its settings and an impl of
+//! [`PhysicsTerm`], overriding only the hooks it contributes to. The right-hand side is generic
+//! over dual numbers, which a trait object cannot carry, so [`Term`] dispatches by `match`; the
+//! macro below writes that enum and its dispatch once from the list of terms.
+
+mod armature_reaction;
+mod back_emf_constant;
+mod coulomb_friction;
+mod current_offset;
+mod load_step;
+mod load_torque;
+mod quadratic_drag;
+mod resistance_heating;
+mod speed_gain;
+mod torque_constant;
+mod viscous_friction;
+mod voltage_drop;
+
+pub use armature_reaction::ArmatureReaction;
+pub use back_emf_constant::BackEmfConstant;
+pub use coulomb_friction::CoulombFriction;
+pub use current_offset::CurrentOffset;
+pub use load_step::LoadStep;
+pub use load_torque::LoadTorque;
+pub use quadratic_drag::QuadraticDrag;
+pub use resistance_heating::ResistanceHeating;
+pub use speed_gain::SpeedGain;
+pub use torque_constant::TorqueConstant;
+pub use viscous_friction::ViscousFriction;
+pub use voltage_drop::VoltageDrop;
+
+use crate::parameter::{Prior, Support};
+
+use super::Scalar;
+
+/// The scales of a model, from its nominal values and the record's length: what a "small" or
+/// "large" value of a term's parameter means for this machine. A default prior puts one
+/// standard deviation at an effect of a tenth of the scale it acts on.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Magnitudes {
+    /// The largest supply voltage |U| [V].
+    pub voltage: f64,
+    /// Stall current U/R [A].
+    pub current: f64,
+    /// No-load speed U/c_m [rad/s].
+    pub speed: f64,
+    /// Stall torque c_g·U/R [N·m].
+    pub torque: f64,
+    /// Heat of a start-up: (U²/R) times the mechanical time constant J·R/(c_g·c_m) [J].
+    pub energy: f64,
+    /// Length of the recording [s].
+    pub duration: f64,
+}
+
+/// The share of a magnitude one prior standard deviation stands for.
+pub const PRIOR_SHARE: f64 = 0.1;
+
+/// A parameter a term adds.
+pub struct TermParam {
+    pub key: &'static str,
+    pub unit: &'static str,
+    /// The value when the model file does not give one (an absent effect).
+    pub default: f64,
+    pub support: fn(&Magnitudes) -> Support,
+    pub prior: fn(&Magnitudes) -> Prior,
+}
+
+/// A fixed setting of a term (not calibrated), e.g. the smoothing speed of Coulomb friction.
+pub struct TermSetting {
+    pub key: &'static str,
+    pub unit: &'static str,
+    pub default: f64,
+}
+
+/// A state a term adds to the ODE, with its initial value.
+pub struct TermState {
+    pub name: &'static str,
+    pub initial: f64,
+}
+
+/// The parameters as the right-hand side uses them, extracted once per solve (the divisions by
+/// L and J become multiplications), after the terms that rescale a constant have acted.
+#[derive(Clone, Copy, Debug)]
+pub struct Coefficients<D> {
+    pub resistance: D,
+    pub back_emf_constant: D,
+    pub torque_constant: D,
+    pub viscous_friction: D,
+    pub inverse_inductance: D,
+    pub inverse_inertia: D,
+}
+
+/// The two balances at one instant, as terms amend them: L dI/dt = U − R·I − c_m·ω + voltage
+/// and J dω/dt = c_g·I − d·ω + torque.
+#[derive(Clone, Copy, Debug)]
+pub struct Balance<D> {
+    pub resistance: D,
+    pub torque_constant: D,
+    pub voltage: D,
+    pub torque: D,
+}
+
+/// Where a term is evaluated: the state, its own parameters and its own states.
+pub struct Site<'a, D> {
+    pub t: f64,
+    /// Start of the interval between breakpoints being integrated: a hard step at a breakpoint
+    /// is decided by it, since the step that ends on the breakpoint still sees the old side.
+    pub segment_start: f64,
+    pub current: D,
+    pub speed: D,
+    pub params: &'a [D],
+    pub states: &'a [D],
+}
+
+/// One physics term. Hooks left at their defaults contribute nothing.
+pub trait PhysicsTerm: Sized + Clone + std::fmt::Debug + PartialEq {
+    const NAME: &'static str;
+    /// The equation it adds, for help texts and the README.
+    const EQUATION: &'static str;
+    const PARAMS: &'static [TermParam];
+    const SETTINGS: &'static [TermSetting] = &[];
+    const STATES: &'static [TermState] = &[];
+
+    /// The term with its settings (in the order of `SETTINGS`), or why they are invalid.
+    fn with_settings(settings: &[f64]) -> Result<Self, String>;
+    fn settings(&self) -> Vec<f64> {
+        Vec::new()
+    }
+    /// Why a parameter cannot be calibrated with these settings, if it cannot.
+    fn check_calibrated(&self, _key: &str) -> Result<(), String> {
+        Ok(())
+    }
+    /// Once per solve: rescale a constant of the model.
+    fn adjust<D: Scalar>(&self, _params: &[D], _c: &mut Coefficients<D>) {}
+    /// At every evaluation of the right-hand side.
+    fn contribute<D: Scalar>(&self, _site: &Site<D>, _b: &mut Balance<D>) {}
+    /// Derivatives of the term's own states, after every term has contributed.
+    fn derivatives<D: Scalar>(&self, _site: &Site<D>, _b: &Balance<D>, _d: &mut [D]) {}
+    /// Amends the measured channels (I, ω).
+    fn measure<D: Scalar>(&self, _params: &[D], _channels: &mut [D]) {}
+    /// Times at which the term makes the right-hand side jump, at nominal parameter values.
+    fn breakpoints(&self, _params: &[f64]) -> Vec<f64> {
+        Vec::new()
+    }
+}
+
+/// Settings checked for a finite positive value: a smoothing width of 0 or NaN would divide by 0.
+pub(crate) fn positive_setting(term: &str, key: &str, v: f64) -> Result<f64, String> {
+    if v > 0.0 && v.is_finite() {
+        Ok(v)
+    } else {
+        Err(format!("{term}.{key} = {v} must be a positive number"))
+    }
+}
+
+/// The default prior of a relative change (a factor 1 + k): one sd is a tenth.
+pub(crate) fn relative_prior(_: &Magnitudes) -> Prior {
+    Prior::Normal {
+        mean: 0.0,
+        sd: PRIOR_SHARE,
+    }
+}
+
+pub(crate) fn real(_: &Magnitudes) -> Support {
+    Support::Real
+}
+
+pub(crate) fn positive(_: &Magnitudes) -> Support {
+    Support::Positive
+}
+
+macro_rules! terms {
+    ($($variant:ident),* $(,)?) => {
+        /// An active physics term with its settings.
+        #[derive(Clone, Debug, PartialEq)]
+        pub enum Term {
+            $($variant($variant)),*
+        }
+
+        impl Term {
+            /// Every term's name, in the canonical order in which models list them.
+            pub const NAMES: &'static [&'static str] = &[$(<$variant as PhysicsTerm>::NAME),*];
+
+            /// A term by name with its settings (`None` for an unknown name).
+            pub fn from_name(name: &str, settings: &[f64]) -> Option<Result<Term, String>> {
+                $(if name == <$variant as PhysicsTerm>::NAME {
+                    return Some($variant::with_settings(settings).map(Term::$variant));
+                })*
+                None
+            }
+
+            /// The parameters and settings a term of this name declares.
+            pub fn declarations(
+                name: &str,
+            ) -> Option<(&'static [TermParam], &'static [TermSetting])> {
+                $(if name == <$variant as PhysicsTerm>::NAME {
+                    return Some((
+                        <$variant as PhysicsTerm>::PARAMS,
+                        <$variant as PhysicsTerm>::SETTINGS,
+                    ));
+                })*
+                None
+            }
+
+            /// Place in [`Term::NAMES`].
+            pub fn rank(&self) -> usize {
+                Self::NAMES.iter().position(|n| *n == self.name()).unwrap_or(usize::MAX)
+            }
+
+            pub fn name(&self) -> &'static str {
+                match self { $(Term::$variant(_) => <$variant as PhysicsTerm>::NAME),* }
+            }
+
+            pub fn equation(&self) -> &'static str {
+                match self { $(Term::$variant(_) => <$variant as PhysicsTerm>::EQUATION),* }
+            }
+
+            pub fn params(&self) -> &'static [TermParam] {
+                match self { $(Term::$variant(_) => <$variant as PhysicsTerm>::PARAMS),* }
+            }
+
+            pub fn setting_decls(&self) -> &'static [TermSetting] {
+                match self { $(Term::$variant(_) => <$variant as PhysicsTerm>::SETTINGS),* }
+            }
+
+            pub fn states(&self) -> &'static [TermState] {
+                match self { $(Term::$variant(_) => <$variant as PhysicsTerm>::STATES),* }
+            }
+
+            pub fn settings(&self) -> Vec<f64> {
+                match self { $(Term::$variant(t) => t.settings()),* }
+            }
+
+            pub fn check_calibrated(&self, key: &str) -> Result<(), String> {
+                match self { $(Term::$variant(t) => t.check_calibrated(key)),* }
+            }
+
+            #[inline]
+            pub fn adjust<D: Scalar>(&self, params: &[D], c: &mut Coefficients<D>) {
+                match self { $(Term::$variant(t) => t.adjust(params, c)),* }
+            }
+
+            #[inline]
+            pub fn contribute<D: Scalar>(&self, site: &Site<D>, b: &mut Balance<D>) {
+                match self { $(Term::$variant(t) => t.contribute(site, b)),* }
+            }
+
+            #[inline]
+            pub fn derivatives<D: Scalar>(&self, site: &Site<D>, b: &Balance<D>, d: &mut [D]) {
+                match self { $(Term::$variant(t) => t.derivatives(site, b, d)),* }
+            }
+
+            #[inline]
+            pub fn measure<D: Scalar>(&self, params: &[D], channels: &mut [D]) {
+                match self { $(Term::$variant(t) => t.measure(params, channels)),* }
+            }
+
+            pub fn breakpoints(&self, params: &[f64]) -> Vec<f64> {
+                match self { $(Term::$variant(t) => t.breakpoints(params)),* }
+            }
+        }
+    };
+}
+
+terms!(
+    TorqueConstant,
+    BackEmfConstant,
+    ViscousFriction,
+    CoulombFriction,
+    QuadraticDrag,
+    LoadTorque,
+    LoadStep,
+    VoltageDrop,
+    ResistanceHeating,
+    ArmatureReaction,
+    CurrentOffset,
+    SpeedGain,
+);
+
+impl Term {
+    /// The term with its default settings.
+    pub fn named(name: &str) -> Option<Term> {
+        let (_, settings) = Term::declarations(name)?;
+        let defaults: Vec<f64> = settings.iter().map(|s| s.default).collect();
+        Term::from_name(name, &defaults).and_then(|t| t.ok())
+    }
+}

@@ -1,0 +1,27 @@
+//! A torque constant off by a factor: c_g → c_g·(1 + k) (the paper's φ = 0.9 is k = 1/9).
+
+use super::{Coefficients, PhysicsTerm, TermParam, real, relative_prior};
+use crate::motor::Scalar;
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct TorqueConstant;
+
+impl PhysicsTerm for TorqueConstant {
+    const NAME: &'static str = "torque_constant";
+    const EQUATION: &'static str = "c_g → c_g·(1 + k)";
+    const PARAMS: &'static [TermParam] = &[TermParam {
+        key: "k",
+        unit: "1",
+        default: 0.0,
+        support: real,
+        prior: relative_prior,
+    }];
+
+    fn with_settings(_: &[f64]) -> Result<Self, String> {
+        Ok(Self)
+    }
+
+    fn adjust<D: Scalar>(&self, p: &[D], c: &mut Coefficients<D>) {
+        c.torque_constant *= p[0] + 1.0;
+    }
+}
