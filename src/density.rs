@@ -87,6 +87,12 @@ pub trait FisherMetric: LogDensity {
     }
 }
 
+/// A density that knows where a search for its mode should start (the nominal model, a
+/// least-squares discrepancy, the noise of what is left).
+pub trait StartingPoint: LogDensity {
+    fn initial_point(&mut self) -> Result<Vec<f64>, DensityError>;
+}
+
 /// Counts evaluations, so that ESS per gradient is measured, not guessed.
 #[derive(Clone, Debug)]
 pub struct Counted<P> {

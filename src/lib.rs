@@ -20,6 +20,7 @@ pub mod motor;
 pub mod ode;
 pub mod optimize;
 pub mod parameter;
+pub mod pipeline;
 pub mod plot;
 pub mod sampler;
 pub mod synthetic;

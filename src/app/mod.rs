@@ -5,7 +5,8 @@ pub mod bench;
 pub mod fit;
 pub mod predictive;
 pub mod problem;
-pub mod run;
+/// The fit pipeline, where the commands have always found it.
+pub use crate::pipeline as run;
 pub mod simulate;
 pub mod summarize;
 pub mod table1;

@@ -13,7 +13,7 @@ use nalgebra::DMatrix;
 
 use super::calibrated::{CalibratedParameter, PriorInU};
 use super::settings::ModelSettings;
-use crate::density::{DensityError, FisherMetric, LogDensity};
+use crate::density::{DensityError, FisherMetric, LogDensity, StartingPoint};
 use crate::forward::ForwardModel;
 use crate::parameter::{Prior, Transform};
 
@@ -413,8 +413,9 @@ impl CalibrationPosterior {
         Ok(term.current.outputs.clone())
     }
 
-    /// A sensible start: nominal θ, the discrepancy that least-squares fits the nominal
-    /// residual, and the noise level of what is left.
+    /// A sensible start: nominal θ (or its prior's median where the nominal value is on the
+    /// boundary of the support), the discrepancy that least-squares fits the nominal residual,
+    /// and the noise level of what is left.
     pub fn initial_point(&mut self) -> Result<Vec<f64>, DensityError> {
         let mut x = vec![0.0; self.dim];
         let theta: Vec<f64> = self.theta.iter().map(|t| t.start).collect();
@@ -579,6 +580,12 @@ impl LogDensity for CalibrationPosterior {
 
     fn blocks(&self) -> Vec<Range<usize>> {
         self.blocks.clone()
+    }
+}
+
+impl StartingPoint for CalibrationPosterior {
+    fn initial_point(&mut self) -> Result<Vec<f64>, DensityError> {
+        CalibrationPosterior::initial_point(self)
     }
 }
 

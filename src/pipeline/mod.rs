@@ -1,5 +1,7 @@
-//! Running a sampler on a posterior: MAP start, overdispersed initial points, chains in
-//! parallel, draws to disk, diagnostics. Shared by `fit`, `reproduce` and `bench`.
+//! The fit pipeline, for any density with a gradient, a Fisher metric and a starting point:
+//! MAP and its Laplace approximation, overdispersed initial points, chains in parallel with the
+//! chosen sampler, diagnostics, draws to disk. `fit`, `reproduce`, `bench` (and any command that
+//! needs "fit this model") are thin callers.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -9,9 +11,7 @@ use nalgebra::DVector;
 use rand_distr::{Distribution, StandardNormal};
 use serde::Serialize;
 
-use crate::bayes::CalibrationPosterior;
-use crate::density::Counted;
-use crate::density::{DensityError, LogDensity};
+use crate::density::{Counted, DensityError, FisherMetric, LogDensity, StartingPoint};
 use crate::diagnostics::{ParameterSummary, summarize};
 use crate::io::{CmdStanWriter, SamplerColumns};
 use crate::optimize::{MapEstimate, MapSettings, find_map};
@@ -27,7 +27,12 @@ use crate::sampler::metropolis::{Metropolis, PyMc3Tuning};
 use crate::sampler::nuts::{Nuts, NutsSettings};
 use crate::sampler::{Adaptation, ChainOutput, ChainSettings, Kernel, run_chains};
 
-use super::AppError;
+use crate::app::AppError;
+
+/// What the pipeline can fit: a log density with a gradient and a Gauss–Newton metric that
+/// knows a sensible point to start a search from, and that chains can clone.
+pub trait Fittable: FisherMetric + StartingPoint + Clone + Send + Sync {}
+impl<P: FisherMetric + StartingPoint + Clone + Send + Sync> Fittable for P {}
 
 /// The samplers a user can pick.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, clap::ValueEnum)]
@@ -164,15 +169,15 @@ impl RunOutput {
 }
 
 /// The MAP from the posterior's own starting point.
-pub fn map_estimate(posterior: &mut CalibrationPosterior) -> Result<MapEstimate, AppError> {
+pub fn map_estimate<P: Fittable>(posterior: &mut P) -> Result<MapEstimate, AppError> {
     let start = posterior.initial_point()?;
     Ok(find_map(posterior, &start, &MapSettings::default())?)
 }
 
 /// Initial points: the MAP plus N(0, (c²) H⁻¹) jitter, on a random stream of its own so the
 /// samplers' streams are untouched. A jittered point with zero density is redrawn closer.
-pub fn initial_points(
-    posterior: &mut CalibrationPosterior,
+pub fn initial_points<P: LogDensity>(
+    posterior: &mut P,
     map: &MapEstimate,
     chains: usize,
     dispersion: f64,
@@ -231,15 +236,16 @@ pub fn progress_bars(
 }
 
 /// Runs any kernel/adaptation pair on clones of the posterior from the given initial points.
-pub fn execute<K, A, F>(
-    posterior: &CalibrationPosterior,
+pub fn execute<P, K, A, F>(
+    posterior: &P,
     inits: &[Vec<f64>],
     settings: &RunSettings,
     label: &str,
     make: F,
 ) -> Result<Vec<(ChainOutput, K)>, AppError>
 where
-    K: Kernel<Counted<CalibrationPosterior>> + Send,
+    P: Fittable,
+    K: Kernel<Counted<P>> + Send,
     A: Adaptation<K>,
     F: Fn(usize) -> Result<(K, A), DensityError> + Sync,
 {
@@ -320,8 +326,8 @@ pub fn finish_run(
 }
 
 /// Runs `settings.sampler` on the posterior from overdispersed starts around the MAP.
-pub fn run_sampler(
-    posterior: &mut CalibrationPosterior,
+pub fn run_sampler<P: Fittable>(
+    posterior: &mut P,
     settings: &RunSettings,
     label: &str,
 ) -> Result<RunOutput, AppError> {
@@ -340,8 +346,8 @@ pub fn run_sampler(
     Ok(finish_run(settings.sampler.name(), chains, &map, started))
 }
 
-fn dispatch(
-    posterior: &CalibrationPosterior,
+fn dispatch<P: Fittable>(
+    posterior: &P,
     map: &MapEstimate,
     inits: &[Vec<f64>],
     settings: &RunSettings,
@@ -404,8 +410,8 @@ fn dispatch(
 
 /// HMC or NUTS: the metric warm-started from the MAP (dense or its diagonal, by the sampler's
 /// name) or a reloaded adaptation, Stan's windows unless reloaded, and the adaptation saved.
-fn hamiltonian<K, B>(
-    posterior: &CalibrationPosterior,
+fn hamiltonian<P, K, B>(
+    posterior: &P,
     map: &MapEstimate,
     inits: &[Vec<f64>],
     settings: &RunSettings,
@@ -413,7 +419,8 @@ fn hamiltonian<K, B>(
     build: B,
 ) -> Result<Vec<ChainOutput>, AppError>
 where
-    K: Kernel<Counted<CalibrationPosterior>> + HamiltonianKernel + Send,
+    P: Fittable,
+    K: Kernel<Counted<P>> + HamiltonianKernel + Send,
     B: Fn(Option<&AdaptationState>, Metric) -> Result<K, String> + Sync,
 {
     let kind = if matches!(
