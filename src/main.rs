@@ -5,6 +5,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use motorcal::app::{self, AppError};
+use motorcal::bayes::{CoefficientFamily, CoefficientPrior};
 
 #[derive(Parser)]
 #[command(
@@ -95,24 +96,26 @@ struct Table1Args {
 
 #[derive(clap::Args)]
 struct FitArgs {
-    /// The recording (CSV with t, I, omega[, U]).
-    #[arg(long)]
-    data: PathBuf,
-    /// The nominal model (TOML).
+    /// A recording (CSV with t, I, omega[, U]); repeat for several recordings, which share the
+    /// physics and have their own noise and discrepancy.
+    #[arg(long, required = true)]
+    data: Vec<PathBuf>,
+    /// The nominal model (TOML, schema 1 or 2).
     #[arg(long)]
     model: PathBuf,
-    /// Bayesian model: 1 (noise only) or 2 (noise + discrepancy).
-    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(1..=2))]
-    bm: u8,
-    /// Degree K of the Legendre discrepancy (BM2), 0..=40.
-    #[arg(long, default_value_t = 9)]
-    k: usize,
+    /// Bayesian model: 1 (noise only) or 2 (noise + discrepancy); default: the model file's
+    /// [discrepancy], else 2.
+    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=2))]
+    bm: Option<u8>,
+    /// Degree K of the discrepancy (BM2); default: the model file's, else 9.
+    #[arg(long)]
+    k: Option<usize>,
     /// Decay power p of the coefficient prior variance V0/(j+1)^p (0: the paper's prior).
     #[arg(long, default_value_t = 0.0)]
     prior_decay: f64,
     /// Family of the coefficient prior.
-    #[arg(long, value_enum, default_value_t = PriorFamily::Laplace)]
-    prior_family: PriorFamily,
+    #[arg(long, value_enum, default_value_t = CoefficientFamily::Laplace)]
+    prior_family: CoefficientFamily,
     /// Only the MAP and its Laplace approximation, no sampling.
     #[arg(long)]
     map_only: bool,
@@ -121,12 +124,6 @@ struct FitArgs {
     /// Output folder.
     #[arg(long, default_value = "out/fit")]
     out: PathBuf,
-}
-
-#[derive(Clone, Copy, clap::ValueEnum)]
-enum PriorFamily {
-    Laplace,
-    Gaussian,
 }
 
 /// Options shared by every command that samples.
@@ -180,28 +177,16 @@ impl RunArgs {
 }
 
 fn fit(args: FitArgs) -> Result<(), AppError> {
-    use motorcal::bayes::{CoefficientFamily, ModelSettings};
-    if args.bm == 2 && args.k > motorcal::bayes::basis::MAX_LEGENDRE_DEGREE {
-        return Err(AppError::Usage(format!(
-            "--k {}: the discrepancy degree must be at most {}",
-            args.k,
-            motorcal::bayes::basis::MAX_LEGENDRE_DEGREE
-        )));
-    }
-    let mut settings = if args.bm == 1 {
-        ModelSettings::bm1()
-    } else {
-        ModelSettings::bm2(args.k)
-    };
-    settings.coefficient_prior.decay_power = args.prior_decay;
-    settings.coefficient_prior.family = match args.prior_family {
-        PriorFamily::Laplace => CoefficientFamily::Laplace,
-        PriorFamily::Gaussian => CoefficientFamily::Gaussian,
-    };
     let options = app::fit::FitOptions {
         data: args.data,
         model: args.model,
-        settings,
+        bm: args.bm,
+        k: args.k,
+        coefficient_prior: CoefficientPrior {
+            family: args.prior_family,
+            decay_power: args.prior_decay,
+            ..CoefficientPrior::default()
+        },
         run: (!args.map_only).then(|| args.run.settings()),
         out: args.out,
     };

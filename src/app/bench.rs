@@ -221,7 +221,7 @@ pub fn bench(options: &BenchOptions) -> Result<Vec<BenchRecord>, AppError> {
         ));
     }
     let problem = match (&options.data, &options.model) {
-        (Some(d), Some(m)) => Problem::from_files(d, m)?,
+        (Some(d), Some(m)) => Problem::from_files(std::slice::from_ref(d), m)?,
         (None, None) => Problem::paper(options.seed)?,
         _ => return Err(AppError::Usage("--data and --model go together".into())),
     };

@@ -1,22 +1,28 @@
-//! `motorcal fit`: calibrate a nominal model on a user's recording with BM1 or BM2(K).
+//! `motorcal fit`: calibrate a model file on one or more recordings with BM1 or BM2(K).
 
 use std::path::PathBuf;
 
 use serde::Serialize;
 
-use crate::bayes::ModelSettings;
+use crate::bayes::{CalibrationPosterior, ModelSettings};
 use crate::density::LogDensity;
 use crate::diagnostics::ParameterSummary;
+use crate::pipeline::{RunOutput, RunSettings, map_estimate, run_sampler, write_draws};
 
 use super::problem::Problem;
-use super::run::{RunSettings, map_estimate, run_sampler, write_draws};
 use super::{AppError, predictive, provenance};
 
 #[derive(Clone, Debug)]
 pub struct FitOptions {
-    pub data: PathBuf,
+    /// One or more recordings: the physics is shared, noise and δ are per recording.
+    pub data: Vec<PathBuf>,
     pub model: PathBuf,
-    pub settings: ModelSettings,
+    /// BM1 or BM2 (`Some(1)`, `Some(2)`); `None` takes the model file's `[discrepancy]`.
+    pub bm: Option<u8>,
+    /// The degree K; `None` takes the model file's, else 9.
+    pub k: Option<usize>,
+    /// The coefficients' prior (family, decay); its degree and basis come from `bm`/`k`.
+    pub coefficient_prior: crate::bayes::CoefficientPrior,
     /// `None`: the MAP and its Laplace approximation only.
     pub run: Option<RunSettings>,
     pub out: PathBuf,
@@ -30,30 +36,66 @@ pub struct MapRow {
     pub laplace_sd: f64,
 }
 
+/// How well one recording's channel is fitted at the posterior mean (the MAP without sampling).
+#[derive(Clone, Debug, Serialize)]
+pub struct ChannelFit {
+    pub record: String,
+    pub channel: String,
+    /// RMS of y − G(θ) − δ(a) at the point.
+    pub rmse: f64,
+    /// The noise σ at the point.
+    pub sigma: f64,
+}
+
 #[derive(Clone, Debug, Serialize)]
 pub struct FitReport {
-    pub data: String,
+    pub data: Vec<String>,
     pub model: String,
     pub settings: ModelSettings,
+    /// What was calibrated (the model's names, `term.key` for a term's parameters).
+    pub calibrated: Vec<String>,
     pub map: Vec<MapRow>,
     pub map_log_density: f64,
+    /// The log likelihood (priors excluded) at the MAP.
+    pub map_log_likelihood: f64,
     pub log_evidence_laplace: f64,
     pub sampler: Option<String>,
+    /// The run's settings, seed included (absent for `--map-only`).
+    pub run_settings: Option<RunSettings>,
+    pub seed: Option<u64>,
     pub summaries: Vec<ParameterSummary>,
+    /// The log likelihood at the posterior mean (in the unconstrained coordinates).
+    pub posterior_mean_log_likelihood: Option<f64>,
+    /// RMSE per channel and recording at the posterior mean (at the MAP without sampling).
+    pub fit: Vec<ChannelFit>,
     pub max_rhat: Option<f64>,
     pub min_ess_bulk: Option<f64>,
+    pub divergences: Option<usize>,
     pub wall_seconds: Option<f64>,
     pub outputs: Vec<String>,
     pub provenance: Vec<(String, String)>,
 }
 
+/// The settings a fit runs with: the model file's discrepancy unless `bm`/`k` override it.
+pub fn model_settings(problem: &Problem, options: &FitOptions) -> Result<ModelSettings, AppError> {
+    let mut settings = problem.model_settings(options.bm, options.k);
+    settings.coefficient_prior = options.coefficient_prior;
+    settings.validate().map_err(|e| {
+        AppError::Usage(match options.k {
+            Some(k) => format!("--k {k}: {e}"),
+            None => e,
+        })
+    })?;
+    Ok(settings)
+}
+
 pub fn fit(options: &FitOptions) -> Result<FitReport, AppError> {
-    options.settings.validate().map_err(AppError::Usage)?;
     if let Some(run) = &options.run {
         run.validate()?;
     }
     let problem = Problem::from_files(&options.data, &options.model)?;
-    let mut posterior = problem.posterior(&options.settings)?;
+    let settings = model_settings(&problem, options)?;
+    let mut posterior = problem.posterior(&settings)?;
     let map = map_estimate(&mut posterior)?;
     let names = posterior.parameter_names();
     let sd = map.laplace_sd();
@@ -68,64 +110,45 @@ pub fn fit(options: &FitOptions) -> Result<FitReport, AppError> {
         })
         .collect();
     let mut report = FitReport {
-        data: options.data.display().to_string(),
+        data: options
+            .data
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect(),
         model: options.model.display().to_string(),
-        settings: options.settings.clone(),
+        settings: settings.clone(),
+        calibrated: posterior
+            .calibrated()
+            .iter()
+            .map(|c| c.name.clone())
+            .collect(),
         map: map_rows,
         map_log_density: map.log_density,
+        map_log_likelihood: posterior.log_likelihood(&map.x)?,
         log_evidence_laplace: map.log_evidence_laplace,
         sampler: None,
+        run_settings: options.run.clone(),
+        seed: options.run.as_ref().map(|r| r.seed),
         summaries: Vec::new(),
+        posterior_mean_log_likelihood: None,
+        fit: channel_fits(&mut posterior, &map.x)?,
         max_rhat: None,
         min_ess_bulk: None,
+        divergences: None,
         wall_seconds: None,
         outputs: Vec::new(),
         provenance: provenance(),
     };
     if let Some(run_settings) = &options.run {
-        let run = run_sampler(&mut posterior, run_settings, &options.settings.label())?;
-        let mut meta = provenance();
-        meta.push(("data".into(), report.data.clone()));
-        meta.push(("model_file".into(), report.model.clone()));
-        meta.push(("model".into(), options.settings.label()));
-        meta.push((
-            "settings".into(),
-            serde_json::to_string(run_settings).unwrap_or_default(),
-        ));
-        meta.push(("seed".into(), run_settings.seed.to_string()));
-        for path in write_draws(&options.out, "fit", &run, &meta)? {
-            report.outputs.push(path.display().to_string());
-        }
-        let p = predictive::posterior_predictive(&mut posterior, &run.chains)?;
-        let csv = options.out.join("predictive.csv");
-        predictive::write_predictive_csv(&csv, &p)?;
-        let png = options.out.join("predictive.png");
-        let title = format!(
-            "{} — {} on {}",
-            options.settings.label(),
-            run.sampler,
-            report.data
-        );
-        predictive::plot_predictive(&png, &title, &p)?;
-        let traces = options.out.join("traces.png");
-        let theta: Vec<(&str, Option<f64>)> = run
-            .summaries
-            .iter()
-            .take(3)
-            .map(|s| (s.name.as_str(), None))
-            .collect();
-        predictive::plot_traces(&traces, &title, &run.chains, &theta)?;
-        if options.settings.discrepancy_degree.is_some() {
-            let png = options.out.join("discrepancy.png");
-            predictive::plot_discrepancy(&png, &format!("δ of {title}"), &p, None)?;
-            report.outputs.push(png.display().to_string());
-        }
-        report
-            .outputs
-            .extend([csv, png, traces].iter().map(|p| p.display().to_string()));
+        let run = run_sampler(&mut posterior, run_settings, &settings.label())?;
+        write_run_outputs(&mut posterior, &run, options, &settings, &mut report)?;
+        let mean = posterior_mean(&run);
+        report.posterior_mean_log_likelihood = Some(posterior.log_likelihood(&mean)?);
+        report.fit = channel_fits(&mut posterior, &mean)?;
         report.sampler = Some(run.sampler.clone());
         report.max_rhat = Some(run.max_rhat);
         report.min_ess_bulk = Some(run.min_ess_bulk);
+        report.divergences = Some(run.divergences);
         report.wall_seconds = Some(run.wall_seconds);
         report.summaries = run.summaries;
     }
@@ -137,37 +160,145 @@ pub fn fit(options: &FitOptions) -> Result<FitReport, AppError> {
     Ok(report)
 }
 
+/// The mean of every chain's unconstrained draws.
+pub fn posterior_mean(run: &RunOutput) -> Vec<f64> {
+    let all: Vec<&Vec<f64>> = run
+        .chains
+        .iter()
+        .flat_map(|c| c.unconstrained.iter())
+        .collect();
+    let d = all.first().map_or(0, |x| x.len());
+    let mut mean = vec![0.0; d];
+    for x in &all {
+        for (m, v) in mean.iter_mut().zip(x.iter()) {
+            *m += v / all.len() as f64;
+        }
+    }
+    mean
+}
+
+/// RMSE and σ of every recording's channels at x.
+pub fn channel_fits(
+    posterior: &mut CalibrationPosterior,
+    x: &[f64],
+) -> Result<Vec<ChannelFit>, AppError> {
+    let mut fits = Vec::new();
+    for r in 0..posterior.n_records() {
+        let residuals = posterior.residuals(x, r)?;
+        for (c, name) in posterior.channel_names(r).into_iter().enumerate() {
+            let res = &residuals[c];
+            fits.push(ChannelFit {
+                record: posterior.record_label(r).to_string(),
+                channel: name,
+                rmse: (res.iter().map(|v| v * v).sum::<f64>() / res.len() as f64).sqrt(),
+                sigma: x[posterior.log_sigma_index(r, c)].exp(),
+            });
+        }
+    }
+    Ok(fits)
+}
+
+/// Draws, and per recording the predictive CSV and the figures.
+fn write_run_outputs(
+    posterior: &mut CalibrationPosterior,
+    run: &RunOutput,
+    options: &FitOptions,
+    settings: &ModelSettings,
+    report: &mut FitReport,
+) -> Result<(), AppError> {
+    let mut meta = provenance();
+    meta.push(("data".into(), report.data.join(" ")));
+    meta.push(("model_file".into(), report.model.clone()));
+    meta.push(("model".into(), settings.label()));
+    if let Some(run_settings) = &options.run {
+        meta.push((
+            "settings".into(),
+            serde_json::to_string(run_settings).unwrap_or_default(),
+        ));
+        meta.push(("seed".into(), run_settings.seed.to_string()));
+    }
+    for path in write_draws(&options.out, "fit", run, &meta)? {
+        report.outputs.push(path.display().to_string());
+    }
+    let several = posterior.n_records() > 1;
+    for r in 0..posterior.n_records() {
+        let suffix = if several {
+            format!("-r{}", r + 1)
+        } else {
+            String::new()
+        };
+        let p = predictive::posterior_predictive(posterior, &run.chains, r)?;
+        let csv = options.out.join(format!("predictive{suffix}.csv"));
+        predictive::write_predictive_csv(&csv, &p)?;
+        let png = options.out.join(format!("predictive{suffix}.png"));
+        let title = format!(
+            "{} — {} on {}",
+            settings.label(),
+            run.sampler,
+            posterior.record_label(r)
+        );
+        predictive::plot_predictive(&png, &title, &p)?;
+        report
+            .outputs
+            .extend([&csv, &png].iter().map(|p| p.display().to_string()));
+        if settings.discrepancy_degree.is_some() {
+            let png = options.out.join(format!("discrepancy{suffix}.png"));
+            predictive::plot_discrepancy(&png, &format!("δ of {title}"), &p, None)?;
+            report.outputs.push(png.display().to_string());
+        }
+    }
+    let traces = options.out.join("traces.png");
+    let title = format!("{} — {}", settings.label(), run.sampler);
+    let shown: Vec<(&str, Option<f64>)> = run
+        .summaries
+        .iter()
+        .take(3)
+        .map(|s| (s.name.as_str(), None))
+        .collect();
+    predictive::plot_traces(&traces, &title, &run.chains, &shown)?;
+    report.outputs.push(traces.display().to_string());
+    Ok(())
+}
+
 pub fn format_report(report: &FitReport) -> String {
     let mut out = format!(
-        "{} on {} (model {})\n",
+        "{} on {} (model {}; calibrated: {})\n",
         report.settings.label(),
-        report.data,
-        report.model
+        report.data.join(" + "),
+        report.model,
+        report.calibrated.join(", ")
     );
     out.push_str(&format!(
-        "MAP: log density {:.3}, Laplace log evidence {:.3}\n",
-        report.map_log_density, report.log_evidence_laplace
+        "MAP: log density {:.3}, log likelihood {:.3}, Laplace log evidence {:.3}\n",
+        report.map_log_density, report.map_log_likelihood, report.log_evidence_laplace
     ));
     if report.summaries.is_empty() {
         out.push_str(&format!(
-            "{:<16} {:>14} {:>12}\n",
+            "{:<24} {:>14} {:>12}\n",
             "parameter", "MAP", "Laplace sd"
         ));
         for row in &report.map {
             out.push_str(&format!(
-                "{:<16} {:>14.6e} {:>12.4e}\n",
+                "{:<24} {:>14.6e} {:>12.4e}\n",
                 row.name, row.value, row.laplace_sd
             ));
         }
     } else {
         out.push_str(&format!(
-            "sampler {}: max R-hat {:.4}, min bulk ESS {:.0}, {:.1} s\n",
+            "sampler {}: max R-hat {:.4}, min bulk ESS {:.0}, {} divergences, {:.1} s\n",
             report.sampler.as_deref().unwrap_or("?"),
             report.max_rhat.unwrap_or(f64::NAN),
             report.min_ess_bulk.unwrap_or(f64::NAN),
+            report.divergences.unwrap_or(0),
             report.wall_seconds.unwrap_or(f64::NAN)
         ));
         out.push_str(&super::summarize::format_table(&report.summaries));
+    }
+    for f in &report.fit {
+        out.push_str(&format!(
+            "fit {} {}: RMSE {:.4}, sigma {:.4}\n",
+            f.record, f.channel, f.rmse, f.sigma
+        ));
     }
     for o in &report.outputs {
         out.push_str(&format!("wrote {o}\n"));

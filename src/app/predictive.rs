@@ -52,10 +52,11 @@ fn quantile(sorted: &[f64], q: f64) -> f64 {
     sorted[lo] + (h - lo as f64) * (sorted[hi] - sorted[lo])
 }
 
-/// The posterior predictive of the first recording from the chains' unconstrained draws.
+/// The posterior predictive of recording `record` from the chains' unconstrained draws.
 pub fn posterior_predictive(
     posterior: &mut CalibrationPosterior,
     chains: &[ChainOutput],
+    record: usize,
 ) -> Result<Predictive, AppError> {
     let all: Vec<&Vec<f64>> = chains.iter().flat_map(|c| c.unconstrained.iter()).collect();
     if all.is_empty() {
@@ -70,22 +71,22 @@ pub fn posterior_predictive(
             *m += v / all.len() as f64;
         }
     }
-    let times = posterior.forward(0).times().to_vec();
+    let times = posterior.forward(record).times().to_vec();
     let m = times.len();
     let names: Vec<String> = posterior
-        .forward(0)
+        .forward(record)
         .channels()
         .iter()
         .map(|s| s.to_string())
         .collect();
-    let model_at_mean = posterior.simulate(&mean_x, 0)?;
+    let model_at_mean = posterior.simulate(&mean_x, record)?;
     // totals[c][draw][i] and discrepancies likewise
     let mut totals = vec![Vec::with_capacity(picked.len()); names.len()];
     let mut deltas = vec![Vec::with_capacity(picked.len()); names.len()];
     for x in &picked {
-        let g = posterior.simulate(x, 0)?;
+        let g = posterior.simulate(x, record)?;
         for c in 0..names.len() {
-            let delta = posterior.discrepancy(x, 0, c);
+            let delta = posterior.discrepancy(x, record, c);
             totals[c].push(
                 (0..m)
                     .map(|i| g[c * m + i] + delta[i])
@@ -114,12 +115,12 @@ pub fn posterior_predictive(
     for (c, name) in names.iter().enumerate() {
         let (mean, lower, upper) = band(&totals[c]);
         let (dm, dl, du) = band(&deltas[c]);
-        let si = posterior.log_sigma_index(0, c);
+        let si = posterior.log_sigma_index(record, c);
         let sigma = all.iter().map(|x| x[si].exp()).sum::<f64>() / all.len() as f64;
         channels.push(ChannelPredictive {
             name: name.clone(),
             unit: unit_of(name).into(),
-            measured: posterior.observed(0, c).to_vec(),
+            measured: posterior.observed(record, c).to_vec(),
             model: model_at_mean[c * m..(c + 1) * m].to_vec(),
             mean,
             lower,

@@ -1,12 +1,12 @@
 //! A calibration problem: recordings plus the nominal model the user believes, from files or
 //! from the paper's synthetic set-up.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-use crate::bayes::{CalibrationPosterior, ModelSettings, Observations};
+use crate::bayes::{CalibratedParameter, CalibrationPosterior, ModelSettings, Observations};
 use crate::forward::ForwardModel;
 use crate::io::{ModelFile, Recording, read_model_file, read_recording};
-use crate::motor::{MOTOR_CHANNELS, MotorModel, MotorParameters, VoltageInput};
+use crate::motor::{MotorModel, MotorParameters, VoltageInput};
 use crate::ode::SolverSettings;
 use crate::synthetic::{PaperSetup, SyntheticData, paper_measurements};
 
@@ -22,11 +22,12 @@ pub struct Reference {
     pub discrepancy: Vec<Vec<f64>>,
 }
 
-/// One recording and the model it is calibrated with.
+/// Recordings and the model they are calibrated with: the physics is shared, the noise and
+/// the discrepancy belong to each recording.
 #[derive(Clone, Debug)]
 pub struct Problem {
     pub label: String,
-    pub recording: Recording,
+    pub recordings: Vec<Recording>,
     pub model: ModelFile,
     pub reference: Option<Reference>,
 }
@@ -44,46 +45,155 @@ impl Problem {
         let reference = paper_reference(&setup, &data, &model.motor)?;
         Ok(Self {
             label: format!("paper synthetic data (seed {seed})"),
-            recording: recording_from(&data, "paper synthetic data"),
+            recordings: vec![recording_from(&data, "paper synthetic data")],
             model,
             reference: Some(reference),
         })
     }
 
-    pub fn from_files(data: &Path, model: &Path) -> Result<Self, AppError> {
+    /// Recordings (one or more) and a model file; every recording is read with the model
+    /// file's `[channels]`.
+    pub fn from_files(data: &[PathBuf], model: &Path) -> Result<Self, AppError> {
+        if data.is_empty() {
+            return Err(AppError::Usage("no recording given (--data)".into()));
+        }
         let model_file = read_model_file(model)?;
-        let recording = read_recording(data, &model_file.channels)?;
+        let recordings = data
+            .iter()
+            .map(|path| read_recording(path, &model_file.channels))
+            .collect::<Result<Vec<_>, _>>()?;
+        let label = data
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect::<Vec<_>>()
+            .join(" + ");
         Ok(Self {
-            label: data.display().to_string(),
-            recording,
+            label,
+            recordings,
             model: model_file,
             reference: None,
         })
     }
 
-    /// The forward model of the recording with R calibrated.
-    pub fn forward(&self, solver: SolverSettings) -> Result<ForwardModel, AppError> {
-        let motor = MotorModel::new(self.model.motor.clone(), self.recording.voltage_input());
-        ForwardModel::new(motor, self.recording.time.clone(), &["R"], solver)
+    /// The first (for the paper's problem, the only) recording.
+    pub fn recording(&self) -> &Recording {
+        &self.recordings[0]
+    }
+
+    /// The model driven by a recording's input, with the model file's terms.
+    pub fn model_for(&self, recording: &Recording) -> Result<MotorModel, AppError> {
+        self.model
+            .model(recording.voltage_input())
             .map_err(AppError::Usage)
     }
 
-    pub fn posterior(&self, settings: &ModelSettings) -> Result<CalibrationPosterior, AppError> {
-        let forward = self.forward(SolverSettings::default())?;
-        let channels = MOTOR_CHANNELS
+    /// What is calibrated: the `[calibrate]` table's parameters in the order of the model's
+    /// parameter vector, or R alone.
+    pub fn calibrated_names(&self) -> Result<Vec<String>, AppError> {
+        let Some(entries) = &self.model.calibrate else {
+            return Ok(vec!["R".into()]);
+        };
+        let model = self.model_for(self.recording())?;
+        let mut names: Vec<(usize, String)> = entries
             .iter()
-            .map(|name| {
-                self.recording
-                    .channel(name)
-                    .map(|v| v.to_vec())
-                    .ok_or_else(|| AppError::Usage(format!("{}: no channel '{name}'", self.label)))
+            .map(|e| {
+                model
+                    .parameter_index(&e.name)
+                    .map(|i| (i, e.name.clone()))
+                    .ok_or_else(|| AppError::Usage(format!("unknown parameter '{}'", e.name)))
+            })
+            .collect::<Result<_, _>>()?;
+        names.sort();
+        Ok(names.into_iter().map(|(_, n)| n).collect())
+    }
+
+    /// The forward model of each recording.
+    pub fn forward_models(&self, solver: SolverSettings) -> Result<Vec<ForwardModel>, AppError> {
+        let calibrated = self.calibrated_names()?;
+        self.recordings
+            .iter()
+            .map(|r| {
+                ForwardModel::new(self.model_for(r)?, r.time.clone(), &calibrated, solver)
+                    .map_err(|e| AppError::Usage(format!("{}: {e}", r.source)))
+            })
+            .collect()
+    }
+
+    /// The forward model of the first recording.
+    pub fn forward(&self, solver: SolverSettings) -> Result<ForwardModel, AppError> {
+        Ok(self.forward_models(solver)?.remove(0))
+    }
+
+    /// BM1/BM2 as the model file's `[discrepancy]` says, unless the command line said otherwise
+    /// (`bm`: 1 or 2, `k`: the degree).
+    pub fn model_settings(&self, bm: Option<u8>, k: Option<usize>) -> ModelSettings {
+        let from_file = self.model.discrepancy.as_ref();
+        let mut settings = ModelSettings::default();
+        if let Some(d) = from_file {
+            settings.discrepancy_degree = d.basis.map(|_| d.degree);
+            if let Some(basis) = d.basis {
+                settings.discrepancy_basis = basis;
+            }
+        }
+        let degree = k
+            .or(from_file.map(|d| d.degree))
+            .unwrap_or(ModelSettings::default().discrepancy_degree.unwrap_or(9));
+        match bm {
+            Some(1) => settings.discrepancy_degree = None,
+            Some(_) => settings.discrepancy_degree = Some(degree),
+            None if k.is_some() => settings.discrepancy_degree = Some(degree),
+            None => {}
+        }
+        settings
+    }
+
+    pub fn posterior(&self, settings: &ModelSettings) -> Result<CalibrationPosterior, AppError> {
+        let forwards = self.forward_models(SolverSettings::default())?;
+        let mut records = Vec::new();
+        for (forward, recording) in forwards.into_iter().zip(&self.recordings) {
+            let channels = forward
+                .channels()
+                .iter()
+                .map(|name| {
+                    recording.channel(name).map(|v| v.to_vec()).ok_or_else(|| {
+                        AppError::Usage(format!("{}: no channel '{name}'", recording.source))
+                    })
+                })
+                .collect::<Result<Vec<_>, _>>()?;
+            let obs = Observations {
+                label: if self.recordings.len() > 1 {
+                    recording.source.clone()
+                } else {
+                    self.label.clone()
+                },
+                channels,
+            };
+            records.push((forward, obs));
+        }
+        let Some(entries) = &self.model.calibrate else {
+            return CalibrationPosterior::new(records, settings).map_err(AppError::Usage);
+        };
+        // Priors scaled to the longest recording: a load step may happen in any of them.
+        let longest = records
+            .iter()
+            .max_by(|a, b| {
+                let end = |f: &ForwardModel| f.times().last().copied().unwrap_or(0.0);
+                end(&a.0).total_cmp(&end(&b.0))
+            })
+            .map(|(f, _)| f.calibrated_specs())
+            .unwrap_or_default();
+        let theta = longest
+            .iter()
+            .map(|spec| {
+                let prior = entries
+                    .iter()
+                    .find(|e| e.name == spec.name)
+                    .and_then(|e| e.prior);
+                CalibratedParameter::new(spec, prior)
+                    .map_err(|e| AppError::Usage(format!("{}: {e}", self.label)))
             })
             .collect::<Result<Vec<_>, _>>()?;
-        let obs = Observations {
-            label: self.label.clone(),
-            channels,
-        };
-        CalibrationPosterior::new(vec![(forward, obs)], settings).map_err(AppError::Usage)
+        CalibrationPosterior::with_parameters(records, theta, settings).map_err(AppError::Usage)
     }
 }
 

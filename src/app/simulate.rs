@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use serde::{Deserialize, Serialize};
 
 use crate::io::{ModelFile, Recording, read_model_file, write_model_file, write_recording};
-use crate::motor::{MotorModel, MotorParameters, VoltageInput};
+use crate::motor::{MotorParameters, VoltageInput};
 use crate::synthetic::{DEFAULT_SEED, generate, sample_times};
 
 use super::AppError;
@@ -135,7 +135,9 @@ pub fn simulate(options: &SimulateOptions) -> Result<SimulateReport, AppError> {
     };
     let times = sample_times(options.t_end, options.samples);
     let input = options.input.voltage(truth_file.motor.voltage, &times);
-    let model = MotorModel::new(truth_file.motor.clone(), input.clone());
+    let model = truth_file
+        .model(input.clone())
+        .map_err(|e| AppError::Usage(format!("--truth: {e}")))?;
     let data = generate(&model, &times, &options.noise_sd, options.seed)
         .map_err(|e| AppError::Numerical(e.to_string()))?;
     let voltage = match input {

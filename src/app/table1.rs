@@ -240,7 +240,7 @@ pub fn reproduce_table1(options: &Table1Options) -> Result<Table1Report, AppErro
             )?;
             if bm2 {
                 let predictive =
-                    super::predictive::posterior_predictive(&mut posterior, &run.chains)?;
+                    super::predictive::posterior_predictive(&mut posterior, &run.chains, 0)?;
                 super::predictive::plot_discrepancy(
                     &options
                         .out

@@ -392,6 +392,48 @@ impl CalibrationPosterior {
             .map(|d| d.description.clone())
     }
 
+    /// The residuals y − G(θ) − δ(a) of every channel of a record at x.
+    pub fn residuals(&mut self, x: &[f64], record: usize) -> Result<Vec<Vec<f64>>, DensityError> {
+        let theta = self.theta_of(x);
+        let term = &mut self.records[record];
+        term.ensure_forward(&theta, false)?;
+        let mut out = Vec::with_capacity(term.channels.len());
+        for c in 0..term.channels.len() {
+            term.residual(c, x);
+            out.push(term.residual.clone());
+        }
+        Ok(out)
+    }
+
+    /// The log likelihood at x, priors and Jacobians left out: the fit's own measure, comparable
+    /// between models with different priors.
+    pub fn log_likelihood(&mut self, x: &[f64]) -> Result<f64, DensityError> {
+        let mut total = 0.0;
+        for r in 0..self.records.len() {
+            for (c, residual) in self.residuals(x, r)?.iter().enumerate() {
+                let s = x[self.records[r].channels[c].log_sigma_index];
+                let ss: f64 = residual.iter().map(|v| v * v).sum();
+                total +=
+                    -(residual.len() as f64) * (s + 0.5 * LN_2PI) - 0.5 * ss * (-2.0 * s).exp();
+            }
+        }
+        Ok(total)
+    }
+
+    /// Names of a record's channels.
+    pub fn channel_names(&self, record: usize) -> Vec<String> {
+        self.records[record]
+            .channels
+            .iter()
+            .map(|c| c.name.clone())
+            .collect()
+    }
+
+    /// The label a record was given (its file, for several recordings).
+    pub fn record_label(&self, record: usize) -> &str {
+        &self.records[record].label
+    }
+
     /// δ of a record's channel at the sample times for the coefficients in x (zeros in BM1).
     pub fn discrepancy(&self, x: &[f64], record: usize, channel: usize) -> Vec<f64> {
         let ch = &self.records[record].channels[channel];

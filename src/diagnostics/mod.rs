@@ -383,6 +383,9 @@ pub struct ParameterSummary {
     pub q05: f64,
     pub q50: f64,
     pub q95: f64,
+    /// The 95% interval beside the 90% one.
+    pub q025: f64,
+    pub q975: f64,
     pub mcse_mean: f64,
     pub ess_bulk: f64,
     pub ess_tail: f64,
@@ -419,6 +422,8 @@ pub fn summarize<C: AsRef<[f64]>>(name: impl Into<String>, chains: &[C]) -> Para
         q05: quantile_sorted(&s, 0.05),
         q50: quantile_sorted(&s, 0.5),
         q95: quantile_sorted(&s, 0.95),
+        q025: quantile_sorted(&s, 0.025),
+        q975: quantile_sorted(&s, 0.975),
         mcse_mean: diag(mcse_mean_of),
         ess_bulk: diag(ess_bulk_of),
         ess_tail: diag(ess_tail_of),

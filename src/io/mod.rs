@@ -12,6 +12,7 @@ mod atomic;
 mod draws;
 mod error;
 mod model_file;
+mod model_tables;
 mod recording;
 mod table;
 
@@ -22,4 +23,5 @@ pub use model_file::{
     MODEL_FILE_SCHEMA, ModelFile, parse_model_file, read_model_file, to_toml_string,
     write_model_file,
 };
+pub use model_tables::{CalibrateEntry, DiscrepancyChoice};
 pub use recording::{ChannelMap, Recording, read_recording, write_recording};

@@ -4,42 +4,80 @@
 use std::io;
 use std::path::Path;
 
-use serde::{Deserialize, Serialize};
+use serde::Deserialize;
 
 use super::atomic::write_atomically;
 use super::error::{InputError, line_and_column, read_text};
+use super::model_tables::{
+    CalibrateEntry, DiscrepancyChoice, RawDiscrepancy, parse_calibrate, parse_discrepancy,
+    parse_terms, toml_number, write_tables,
+};
 use super::recording::ChannelMap;
-use crate::motor::{MotorParam, MotorParameters};
+use crate::motor::{ActiveTerm, MotorModel, MotorParam, MotorParameters, VoltageInput};
 
-/// The model-file format version this build reads and writes.
-pub const MODEL_FILE_SCHEMA: u32 = 1;
+/// The newest model-file format version this build reads and writes. Schema 1 (the motor and
+/// the channels) is still read, and means what it always meant.
+pub const MODEL_FILE_SCHEMA: u32 = 2;
 
-/// A model file. Every table refuses unknown keys, so a misspelt key is an error instead of a
-/// silently ignored setting; missing keys take their defaults.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+/// A model file: the nominal motor, the physics terms switched on, what is calibrated with
+/// which prior, the discrepancy, and which recorded column is which.
+#[derive(Clone, Debug, PartialEq)]
 pub struct ModelFile {
-    /// Format version; files from a newer version are refused rather than misread.
-    #[serde(default = "default_schema")]
     pub schema: u32,
-    #[serde(default)]
     pub motor: MotorParameters,
-    #[serde(default)]
+    /// `[terms.NAME]`, in the canonical order of [`crate::motor::Term::NAMES`].
+    pub terms: Vec<ActiveTerm>,
+    /// `[calibrate]`; `None` when the table is absent: R alone, with the paper's prior, sampled
+    /// as itself (what schema-1 files always meant).
+    pub calibrate: Option<Vec<CalibrateEntry>>,
+    /// `[discrepancy]`; `None` leaves BM1/BM2 and K to the command line's defaults.
+    pub discrepancy: Option<DiscrepancyChoice>,
     pub channels: ChannelMap,
-}
-
-fn default_schema() -> u32 {
-    MODEL_FILE_SCHEMA
 }
 
 impl Default for ModelFile {
     fn default() -> Self {
         Self {
-            schema: MODEL_FILE_SCHEMA,
+            schema: 1,
             motor: MotorParameters::default(),
+            terms: Vec::new(),
+            calibrate: None,
+            discrepancy: None,
             channels: ChannelMap::default(),
         }
     }
+}
+
+impl ModelFile {
+    /// The model driven by `input`, with the file's terms switched on.
+    pub fn model(&self, input: VoltageInput) -> Result<MotorModel, String> {
+        MotorModel::with_terms(self.motor.clone(), input, self.terms.clone())
+    }
+
+    /// Whether anything needs schema 2 to be written.
+    fn needs_schema_2(&self) -> bool {
+        !self.terms.is_empty() || self.calibrate.is_some() || self.discrepancy.is_some()
+    }
+}
+
+/// The file as TOML hands it over; every table refuses unknown keys, so a misspelt key is an
+/// error instead of a silently ignored setting; missing keys take their defaults.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawModelFile {
+    #[serde(default = "schema_1")]
+    schema: u32,
+    #[serde(default)]
+    motor: MotorParameters,
+    terms: Option<toml::Table>,
+    calibrate: Option<toml::Table>,
+    discrepancy: Option<RawDiscrepancy>,
+    #[serde(default)]
+    channels: ChannelMap,
+}
+
+fn schema_1() -> u32 {
+    1
 }
 
 /// Reads and checks a model file: TOML syntax, known keys, value types, the schema version and
@@ -53,26 +91,81 @@ pub fn read_model_file(path: &Path) -> Result<ModelFile, InputError> {
 
 /// Parses model-file text; `path` only names the file in errors.
 pub fn parse_model_file(text: &str, path: &Path) -> Result<ModelFile, InputError> {
-    let model: ModelFile = toml::from_str(text).map_err(|e| toml_error(text, path, &e))?;
+    let raw: RawModelFile = toml::from_str(text).map_err(|e| toml_error(text, path, &e))?;
     let paths = key_paths(text);
+    let headers = table_headers(text);
+    // A key's own line, or else the header of the table it names, or else the line of the first
+    // key inside it.
     let line_of = |key: &str| {
-        paths
-            .iter()
-            .position(|p| p.as_deref() == Some(key))
-            .map(|i| i + 1)
+        let position = |list: &[Option<String>], wanted: &str| {
+            list.iter()
+                .position(|p| p.as_deref() == Some(wanted))
+                .map(|i| i + 1)
+        };
+        position(&paths, key)
+            .or_else(|| position(&headers, key))
+            .or_else(|| {
+                let prefix = format!("{key}.");
+                paths
+                    .iter()
+                    .position(|p| p.as_deref().is_some_and(|p| p.starts_with(&prefix)))
+                    .map(|i| i + 1)
+            })
+            .or_else(|| {
+                // A missing prior argument is reported for `calibrate.NAME.arg`: point at NAME.
+                let parent = key.rsplit_once('.')?.0;
+                position(&paths, parent)
+            })
     };
 
-    if model.schema != MODEL_FILE_SCHEMA {
+    if !(1..=MODEL_FILE_SCHEMA).contains(&raw.schema) {
         return Err(InputError::new(
             path,
             format!(
-                "schema {} is not supported; this version of motorcal reads schema {MODEL_FILE_SCHEMA}",
-                model.schema
+                "schema {} is not supported; this version of motorcal reads schemas 1 and {MODEL_FILE_SCHEMA}",
+                raw.schema
             ),
         )
         .at_line_opt(line_of("schema"))
         .for_field("schema"));
     }
+    if raw.schema == 1 {
+        for (table, present) in [
+            ("terms", raw.terms.is_some()),
+            ("calibrate", raw.calibrate.is_some()),
+            ("discrepancy", raw.discrepancy.is_some()),
+        ] {
+            if present {
+                return Err(InputError::new(
+                    path,
+                    format!("a [{table}] table needs `schema = 2` at the top of the file"),
+                )
+                .at_line_opt(line_of(table))
+                .for_field(table));
+            }
+        }
+    }
+    let mut terms = match &raw.terms {
+        Some(table) => parse_terms(table, path, &line_of)?,
+        None => Vec::new(),
+    };
+    let calibrate = match &raw.calibrate {
+        Some(table) => Some(parse_calibrate(table, &mut terms, path, &line_of)?),
+        None => None,
+    };
+    let discrepancy = match &raw.discrepancy {
+        Some(d) => Some(parse_discrepancy(d, path, &line_of)?),
+        None => None,
+    };
+    terms.sort_by_key(|t| t.term.rank());
+    let model = ModelFile {
+        schema: raw.schema,
+        motor: raw.motor,
+        terms,
+        calibrate,
+        discrepancy,
+        channels: raw.channels,
+    };
     if let Err(message) = model.motor.validate() {
         // validate() reports "KEY = value ..."; the key tells which line to point at.
         let key = message
@@ -86,14 +179,43 @@ pub fn parse_model_file(text: &str, path: &Path) -> Result<ModelFile, InputError
             .at_line_opt(line)
             .for_field_opt(field));
     }
+    if let Err(message) = model.model(VoltageInput::Constant) {
+        let field = (model.motor.load_torque != 0.0).then(|| "motor.T_L".to_string());
+        let line = field.as_deref().and_then(line_of);
+        return Err(InputError::new(path, message)
+            .at_line_opt(line)
+            .for_field_opt(field));
+    }
     Ok(model)
 }
 
-/// The TOML text of a model file, which [`read_model_file`] reads back to the same values.
+/// The TOML text of a model file, which [`read_model_file`] reads back to the same values:
+/// schema 1 when nothing needs more, so that plain files stay readable by older versions.
 pub fn to_toml_string(model: &ModelFile) -> String {
-    // Plain tables of numbers and strings always serialize; this can only fail if ModelFile grows
-    // a type TOML cannot express, which the round-trip test catches.
-    toml::to_string(model).expect("a ModelFile always serializes to TOML")
+    let schema = if model.needs_schema_2() { 2 } else { 1 };
+    let mut out = format!("schema = {schema}\n\n[motor]\n");
+    for p in MotorParam::ALL {
+        out.push_str(&format!(
+            "{} = {}\n",
+            p.key(),
+            toml_number(model.motor.get(p))
+        ));
+    }
+    if model.motor.load_torque != 0.0 {
+        out.push_str(&format!("T_L = {}\n", toml_number(model.motor.load_torque)));
+    }
+    write_tables(
+        &mut out,
+        &model.terms,
+        model.calibrate.as_deref(),
+        model.discrepancy.as_ref(),
+    );
+    let c = &model.channels;
+    out.push_str(&format!(
+        "\n[channels]\nt = {:?}\nI = {:?}\nomega = {:?}\nU = {:?}\n",
+        c.t, c.current, c.speed, c.voltage
+    ));
+    out
 }
 
 /// Writes a model file atomically.
@@ -124,6 +246,17 @@ fn toml_error(text: &str, path: &Path, e: &toml::de::Error) -> InputError {
 fn backticked(message: &str) -> Option<String> {
     let rest = &message[message.find('`')? + 1..];
     Some(rest[..rest.find('`')?].to_owned())
+}
+
+/// For every line of `text`, the dotted path of the table its header opens (`terms.x`), if any.
+fn table_headers(text: &str) -> Vec<Option<String>> {
+    text.lines()
+        .map(|raw| {
+            let line = raw.trim();
+            let inner = line.strip_prefix('[')?.trim_start_matches('[');
+            Some(key_segments(inner.split(']').next().unwrap_or("")).join("."))
+        })
+        .collect()
 }
 
 /// For every line of `text`, the dotted path of the key assigned there (`motor.R`), if any.
@@ -219,7 +352,7 @@ mod tests {
             ("[motor]\nR = \"a\"\n", 2, "motor.R", "invalid type"),
             ("[motor]\nR = 1e400\n", 2, "motor.R", "overflow"),
             ("[motorr]\nR = 1\n", 1, "motorr", "unknown field"),
-            ("schema = 2\n", 1, "schema", "not supported"),
+            ("schema = 3\n", 1, "schema", "not supported"),
             ("schema = -1\n", 1, "schema", "u32"),
             ("\n[motor]\nL = 0.0\n", 3, "motor.L", "positive"),
             ("[motor]\nJ = -1e-5\n", 2, "motor.J", "positive"),
