@@ -4,7 +4,7 @@
 
 use super::{
     Balance, Magnitudes, PRIOR_SHARE, PhysicsTerm, Site, TermParam, TermSetting, positive,
-    positive_setting,
+    positive_setting, tanh,
 };
 use crate::motor::Scalar;
 use crate::parameter::Prior;
@@ -48,6 +48,6 @@ impl PhysicsTerm for CoulombFriction {
     }
 
     fn contribute<D: Scalar>(&self, site: &Site<D>, b: &mut Balance<D>) {
-        b.torque -= site.params[0] * (site.speed / self.omega_s).tanh();
+        b.torque -= site.params[0] * tanh(site.speed / self.omega_s);
     }
 }

@@ -5,7 +5,9 @@
 //! calibratable. Width 0 gives the hard step with a breakpoint at t_s, which the integrator
 //! lands on exactly; t_s is then fixed (profile it over a grid of model files).
 
-use super::{Balance, Magnitudes, PRIOR_SHARE, PhysicsTerm, Site, TermParam, TermSetting, real};
+use super::{
+    Balance, Magnitudes, PRIOR_SHARE, PhysicsTerm, Site, TermParam, TermSetting, logistic, real,
+};
 use crate::motor::Scalar;
 use crate::parameter::{Prior, Support};
 
@@ -93,9 +95,7 @@ impl PhysicsTerm for LoadStep {
                 b.torque -= torque;
             }
         } else {
-            let z = (switch_time - site.t) / self.width;
-            // logistic((t − t_s)/w) = 1/(1 + e^z); exp of a large z overflows to ∞ → 0, as it should.
-            b.torque -= torque / (z.exp() + 1.0);
+            b.torque -= torque * logistic((-switch_time + site.t) / self.width);
         }
     }
 

@@ -148,6 +148,29 @@ pub trait PhysicsTerm: Sized + Clone + std::fmt::Debug + PartialEq {
     }
 }
 
+/// tanh that stays finite for dual numbers: num-dual computes it as sinh/cosh, which is ∞/∞
+/// once |x| passes ~710 — and ω/ω_s does. Written with e^(−2|x|), which only underflows.
+/// The branch is on the real part, so f64 and dual runs take the same one.
+pub fn tanh<D: Scalar>(x: D) -> D {
+    if x.re() >= 0.0 {
+        let e = (x * -2.0).exp();
+        (-e + 1.0) / (e + 1.0)
+    } else {
+        let e = (x * 2.0).exp();
+        (e - 1.0) / (e + 1.0)
+    }
+}
+
+/// The logistic 1/(1 + e^(−x)), finite with its derivatives for any x (same reason as [`tanh`]).
+pub fn logistic<D: Scalar>(x: D) -> D {
+    if x.re() >= 0.0 {
+        ((-x).exp() + 1.0).recip()
+    } else {
+        let e = x.exp();
+        e / (e + 1.0)
+    }
+}
+
 /// Settings checked for a finite positive value: a smoothing width of 0 or NaN would divide by 0.
 pub(crate) fn positive_setting(term: &str, key: &str, v: f64) -> Result<f64, String> {
     if v > 0.0 && v.is_finite() {

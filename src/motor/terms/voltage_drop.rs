@@ -3,7 +3,7 @@
 
 use super::{
     Balance, Magnitudes, PRIOR_SHARE, PhysicsTerm, Site, TermParam, TermSetting, positive,
-    positive_setting,
+    positive_setting, tanh,
 };
 use crate::motor::Scalar;
 use crate::parameter::Prior;
@@ -47,6 +47,6 @@ impl PhysicsTerm for VoltageDrop {
     }
 
     fn contribute<D: Scalar>(&self, site: &Site<D>, b: &mut Balance<D>) {
-        b.voltage -= site.params[0] * (site.current / self.current_scale).tanh();
+        b.voltage -= site.params[0] * tanh(site.current / self.current_scale);
     }
 }
