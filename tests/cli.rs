@@ -222,3 +222,77 @@ fn impossible_options_are_refused_before_any_work() {
     assert_clean_failure(&run(&["--draws", "100", "--keep", "200"]), &["keep 200"]);
     assert_clean_failure(&run(&["--threads", "0"]), &["--threads 0"]);
 }
+
+#[test]
+fn a_bad_schema_2_model_file_is_one_error_line_and_nothing_written() {
+    let dir = scratch("schema2");
+    simulate_into(&dir);
+    let data = dir.join("recording.csv");
+    let out = dir.join("out");
+    for (text, needles) in [
+        (
+            "schema = 2\n[terms.colomb_friction]\nT_c = 0.1\n",
+            &["bad.toml", ":2", "terms.colomb_friction", "unknown term"][..],
+        ),
+        (
+            "schema = 2\n[calibrate]\n\"coulomb_friction.T_c\" = { prior = \"gamma\" }\n",
+            &["bad.toml", ":3", "calibrate.coulomb_friction.T_c.prior"][..],
+        ),
+        (
+            "schema = 2\n[calibrate]\nR = { prior = \"uniform\", lower = 0.05 }\n",
+            &["bad.toml", ":3", "calibrate.R.upper"][..],
+        ),
+    ] {
+        let model = dir.join("bad.toml");
+        std::fs::write(&model, text).unwrap();
+        let o = motorcal(&[
+            "fit",
+            "--data",
+            data.to_str().unwrap(),
+            "--model",
+            model.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--map-only",
+        ]);
+        assert_clean_failure(&o, needles);
+        assert!(!out.join("fit.json").exists());
+    }
+}
+
+#[test]
+fn fit_takes_several_recordings_and_a_schema_2_model() {
+    let dir = scratch("several");
+    simulate_into(&dir);
+    let second = dir.join("second");
+    std::fs::create_dir_all(&second).unwrap();
+    let o = motorcal(&["simulate", "--out", second.to_str().unwrap(), "--seed", "4"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let model = dir.join("model.toml");
+    std::fs::write(
+        &model,
+        "schema = 2\n[motor]\nc_g = 0.009\n[calibrate]\nR = {}\n\"torque_constant.k\" = {}\n\
+         [discrepancy]\nbasis = \"none\"\n",
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let o = motorcal(&[
+        "fit",
+        "--data",
+        dir.join("recording.csv").to_str().unwrap(),
+        "--data",
+        second.join("recording.csv").to_str().unwrap(),
+        "--model",
+        model.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--map-only",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("fit.json")).unwrap()).unwrap();
+    assert_eq!(report["calibrated"], serde_json::json!(["R", "torque_constant.k"]));
+    assert_eq!(report["data"].as_array().unwrap().len(), 2);
+    assert_eq!(report["fit"].as_array().unwrap().len(), 4, "two channels × two records");
+    assert!(report["settings"]["discrepancy_degree"].is_null(), "basis none is BM1");
+}

@@ -106,10 +106,13 @@ pub fn parse_model_file(text: &str, path: &Path) -> Result<ModelFile, InputError
             .or_else(|| position(&headers, key))
             .or_else(|| {
                 let prefix = format!("{key}.");
-                paths
-                    .iter()
-                    .position(|p| p.as_deref().is_some_and(|p| p.starts_with(&prefix)))
-                    .map(|i| i + 1)
+                let starts =
+                    |p: &Option<String>| p.as_deref().is_some_and(|p| p.starts_with(&prefix));
+                let first = |list: &[Option<String>]| list.iter().position(starts);
+                match (first(&headers), first(&paths)) {
+                    (Some(a), Some(b)) => Some(a.min(b) + 1),
+                    (a, b) => a.or(b).map(|i| i + 1),
+                }
             })
             .or_else(|| {
                 // A missing prior argument is reported for `calibrate.NAME.arg`: point at NAME.
@@ -374,6 +377,109 @@ mod tests {
         }
         let e = parse("[motor\nR = 1\n").unwrap_err();
         assert_eq!(e.line, Some(1), "{e}");
+    }
+
+    #[test]
+    fn schema_2_mistakes_name_their_line_and_key() {
+        let cases = [
+            (
+                "schema = 2\n[terms.coulomb]\nT_c = 1.0\n",
+                2,
+                "terms.coulomb",
+                "unknown term",
+            ),
+            (
+                "schema = 2\n[terms.coulomb_friction]\nTc = 1.0\n",
+                3,
+                "terms.coulomb_friction.Tc",
+                "unknown key",
+            ),
+            (
+                "schema = 2\n[terms.coulomb_friction]\nomega_s = 0.0\n",
+                2,
+                "terms.coulomb_friction",
+                "positive",
+            ),
+            (
+                "schema = 2\n[calibrate]\n\"coulomb_friction.Tc\" = {}\n",
+                3,
+                "calibrate.coulomb_friction.Tc",
+                "no parameter 'Tc'",
+            ),
+            (
+                "schema = 2\n[calibrate]\nRR = {}\n",
+                3,
+                "calibrate.RR",
+                "unknown parameter",
+            ),
+            (
+                "schema = 2\n[calibrate]\nR = { prior = \"cauchy\", mean = 0.1 }\n",
+                3,
+                "calibrate.R.prior",
+                "unknown prior family",
+            ),
+            (
+                "schema = 2\n\n[calibrate]\nR = { prior = \"normal\", mean = 0.1 }\n",
+                4,
+                "calibrate.R.sd",
+                "needs 'sd'",
+            ),
+            (
+                "schema = 2\n[calibrate]\nR = { prior = \"normal\", mean = 0.1, sd = -1 }\n",
+                3,
+                "calibrate.R",
+                "positive",
+            ),
+            (
+                "schema = 2\n[calibrate]\nR = { prior = \"half_normal\", scale = 1, sd = 2 }\n",
+                3,
+                "calibrate.R.sd",
+                "takes scale",
+            ),
+            ("[terms.speed_gain]\ng = 0.1\n", 1, "terms", "schema = 2"),
+            (
+                "schema = 2\n[discrepancy]\nbasis = \"fourier\"\n",
+                3,
+                "discrepancy.basis",
+                "unknown basis",
+            ),
+            (
+                "schema = 2\n[discrepancy]\ndegree = 99\n",
+                3,
+                "discrepancy.degree",
+                "larger than",
+            ),
+        ];
+        for (text, line, field, message) in cases {
+            let e = parse(text).unwrap_err();
+            assert_eq!(e.line, Some(line), "{text:?}: {e}");
+            assert_eq!(e.field.as_deref(), Some(field), "{text:?}: {e}");
+            assert!(e.message.contains(message), "{text:?}: {e}");
+            assert!(!e.to_string().contains('\n'));
+        }
+    }
+
+    #[test]
+    fn a_schema_2_file_reads_back_to_the_same_values() {
+        let text = "schema = 2\n[motor]\nR = 0.1\nc_g = 0.01\n[terms.coulomb_friction]\n\
+                    T_c = 0.0\nomega_s = 1.0\n[calibrate]\nR = { prior = \"normal\", mean = 0.1, \
+                    sd = 0.02 }\n\"coulomb_friction.T_c\" = { prior = \"half_normal\", scale = 0.5 }\n\
+                    load_step.t_s = {}\n[discrepancy]\nbasis = \"legendre\"\ndegree = 9\n";
+        let model = parse(text).unwrap();
+        assert_eq!(model.schema, 2);
+        // load_step is switched on by being calibrated; terms come in their canonical order.
+        let names: Vec<&str> = model.terms.iter().map(|t| t.term.name()).collect();
+        assert_eq!(names, ["coulomb_friction", "load_step"]);
+        let calibrate = model.calibrate.as_ref().unwrap();
+        assert_eq!(calibrate.len(), 3);
+        assert_eq!(
+            calibrate[1].prior,
+            Some(crate::parameter::Prior::HalfNormal { scale: 0.5 })
+        );
+        assert_eq!(model.discrepancy.as_ref().unwrap().degree, 9);
+        assert_eq!(parse(&to_toml_string(&model)).unwrap(), model);
+        // A file with nothing of schema 2 is written as schema 1.
+        assert!(to_toml_string(&ModelFile::default()).starts_with("schema = 1"));
     }
 
     #[test]
