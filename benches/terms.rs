@@ -59,7 +59,11 @@ fn bench(c: &mut Criterion) {
         let theta = posterior.theta_of(&x);
         let mut out = vec![0.0; forward.n_outputs()];
         group.bench_function(format!("{label}/f64_solve"), |b| {
-            b.iter(|| forward.simulate(black_box(&theta), &mut out).expect("solve"))
+            b.iter(|| {
+                forward
+                    .simulate(black_box(&theta), &mut out)
+                    .expect("solve")
+            })
         });
         // R moves by ±10⁻³ of itself in its own coordinate (x or log x): three points, so the
         // two-solve cache never hides the ODE.

@@ -291,8 +291,18 @@ fn fit_takes_several_recordings_and_a_schema_2_model() {
     assert!(o.status.success(), "{}", stderr(&o));
     let report: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("fit.json")).unwrap()).unwrap();
-    assert_eq!(report["calibrated"], serde_json::json!(["R", "torque_constant.k"]));
+    assert_eq!(
+        report["calibrated"],
+        serde_json::json!(["R", "torque_constant.k"])
+    );
     assert_eq!(report["data"].as_array().unwrap().len(), 2);
-    assert_eq!(report["fit"].as_array().unwrap().len(), 4, "two channels × two records");
-    assert!(report["settings"]["discrepancy_degree"].is_null(), "basis none is BM1");
+    assert_eq!(
+        report["fit"].as_array().unwrap().len(),
+        4,
+        "two channels × two records"
+    );
+    assert!(
+        report["settings"]["discrepancy_degree"].is_null(),
+        "basis none is BM1"
+    );
 }

@@ -146,6 +146,25 @@ impl RecordTerm {
     }
 }
 
+/// One channel of one recording at a point, as a walk over the likelihood sees it.
+struct Visit<'a> {
+    record: &'a RecordTerm,
+    index: usize,
+    channel: &'a ChannelTerm,
+    log_sigma: f64,
+    /// σ⁻² = e^(−2 log σ).
+    inv_var: f64,
+    /// y − G(θ) − δ(a), when the walk formed it (empty otherwise).
+    residual: &'a [f64],
+}
+
+impl Visit<'_> {
+    /// ∂G/∂θ_k of this channel.
+    fn sensitivities(&self, k: usize) -> &[f64] {
+        self.record.sensitivities(k, self.index)
+    }
+}
+
 /// The posterior of one or several recordings under BM1 or BM2(K).
 #[derive(Clone, Debug)]
 pub struct CalibrationPosterior {
@@ -495,6 +514,39 @@ impl CalibrationPosterior {
         Ok(x)
     }
 
+    /// Visits every channel of every recording at x once, after solving the forward model at
+    /// the θ last written to `theta_x` (with sensitivities if asked) and, if asked, forming the
+    /// channel's residual: the one loop the density, the metric and the information share.
+    fn walk(
+        &mut self,
+        x: &[f64],
+        sensitivities: bool,
+        residuals: bool,
+        mut visit: impl FnMut(&Visit<'_>),
+    ) -> Result<(), DensityError> {
+        let theta = &self.theta_x;
+        for term in &mut self.records {
+            term.ensure_forward(theta, sensitivities)?;
+            for c in 0..term.channels.len() {
+                if residuals {
+                    term.residual(c, x);
+                }
+                let record = &*term;
+                let channel = &record.channels[c];
+                let log_sigma = x[channel.log_sigma_index];
+                visit(&Visit {
+                    record,
+                    index: c,
+                    channel,
+                    log_sigma,
+                    inv_var: (-2.0 * log_sigma).exp(),
+                    residual: if residuals { &record.residual } else { &[] },
+                });
+            }
+        }
+        Ok(())
+    }
+
     /// The priors of θ at the point's u, with θ itself written to `theta_x`; `None` where the
     /// density is zero.
     fn theta_priors(&mut self, x: &[f64]) -> Option<Vec<PriorInU>> {
@@ -532,42 +584,33 @@ impl CalibrationPosterior {
                 g[k] += at.gradient;
             }
         }
-        let need_sensitivities = grad.is_some();
-        let theta = &self.theta_x;
-        for term in &mut self.records {
-            term.ensure_forward(theta, need_sensitivities)?;
-            let m = term.forward.n_samples();
-            for c in 0..term.channels.len() {
-                term.residual(c, x);
-                let ch = &term.channels[c];
-                let s = x[ch.log_sigma_index];
-                let sigma = s.exp();
-                let inv_var = (-2.0 * s).exp();
-                let ss: f64 = term.residual.iter().map(|r| r * r).sum();
-                // Likelihood, the InvGamma prior on σ, and the Jacobian of σ = exp(s).
-                lp += -(m as f64) * (s + 0.5 * LN_2PI) - 0.5 * ss * inv_var;
-                lp += self.noise_prior.log_density(sigma) + s;
-                if let Some(g) = grad.as_deref_mut() {
-                    g[ch.log_sigma_index] +=
-                        -(m as f64) + ss * inv_var + self.noise_prior.gradient(sigma) * sigma + 1.0;
-                    for k in 0..p {
-                        g[k] +=
-                            inv_var * dot(term.sensitivities(k, c), &term.residual) * priors[k].dx;
-                    }
+        let noise_prior = self.noise_prior;
+        self.walk(x, grad.is_some(), true, |v| {
+            let (ch, s, inv_var) = (v.channel, v.log_sigma, v.inv_var);
+            let m = v.residual.len();
+            let sigma = s.exp();
+            let ss: f64 = v.residual.iter().map(|r| r * r).sum();
+            // Likelihood, the InvGamma prior on σ, and the Jacobian of σ = exp(s).
+            lp += -(m as f64) * (s + 0.5 * LN_2PI) - 0.5 * ss * inv_var;
+            lp += noise_prior.log_density(sigma) + s;
+            if let Some(g) = grad.as_deref_mut() {
+                g[ch.log_sigma_index] +=
+                    -(m as f64) + ss * inv_var + noise_prior.gradient(sigma) * sigma + 1.0;
+                for k in 0..p {
+                    g[k] += inv_var * dot(v.sensitivities(k), v.residual) * priors[k].dx;
                 }
-                if let Some(d) = &ch.discrepancy {
-                    for (j, prior) in d.priors.iter().enumerate() {
-                        let a = x[d.offset + j];
-                        lp += prior.log_density(a);
-                        if let Some(g) = grad.as_deref_mut() {
-                            g[d.offset + j] += inv_var
-                                * dot(d.basis.column(j).as_slice(), &term.residual)
-                                + prior.gradient(a);
-                        }
+            }
+            if let Some(d) = &ch.discrepancy {
+                for (j, prior) in d.priors.iter().enumerate() {
+                    let a = x[d.offset + j];
+                    lp += prior.log_density(a);
+                    if let Some(g) = grad.as_deref_mut() {
+                        g[d.offset + j] += inv_var * dot(d.basis.column(j).as_slice(), v.residual)
+                            + prior.gradient(a);
                     }
                 }
             }
-        }
+        })?;
         Ok(lp)
     }
 }
@@ -644,52 +687,44 @@ impl FisherMetric for CalibrationPosterior {
         for (k, at) in priors.iter().enumerate() {
             metric[(k, k)] += at.metric;
         }
-        let theta = &self.theta_x;
-        for term in &mut self.records {
-            term.ensure_forward(theta, true)?;
-            for ch_index in 0..term.channels.len() {
-                let ch = &term.channels[ch_index];
-                let m = ch.observed.len();
-                let s = x[ch.log_sigma_index];
-                let inv_var = (-2.0 * s).exp();
-                let sigma = s.exp();
-                // d²/ds² of −[log p(σ) + s] at σ = e^s for InvGamma(α, β): β/σ.
-                let prior_curv = match self.noise_prior {
-                    Prior::InverseGamma { scale, .. } => scale / sigma,
-                    _ => 0.0,
-                };
-                metric[(ch.log_sigma_index, ch.log_sigma_index)] += 2.0 * m as f64 + prior_curv;
-                for k in 0..p {
-                    let jk = term.sensitivities(k, ch_index);
-                    for l in 0..=k {
-                        let jl = term.sensitivities(l, ch_index);
-                        let v = inv_var * dot(jk, jl) * priors[k].dx * priors[l].dx;
-                        metric[(k, l)] += v;
-                        if l != k {
-                            metric[(l, k)] += v;
-                        }
-                    }
-                }
-                if let Some(d) = &ch.discrepancy {
-                    let n = d.priors.len();
-                    for j in 0..n {
-                        let bj = d.basis.column(j);
-                        for k in 0..p {
-                            let jk = term.sensitivities(k, ch_index);
-                            let v = inv_var * dot(jk, bj.as_slice()) * priors[k].dx;
-                            metric[(k, d.offset + j)] += v;
-                            metric[(d.offset + j, k)] += v;
-                        }
-                        for i in 0..n {
-                            metric[(d.offset + i, d.offset + j)] += inv_var * d.gram[(i, j)];
-                        }
-                        metric[(d.offset + j, d.offset + j)] +=
-                            d.priors[j].curvature(x[d.offset + j]);
+        let noise_prior = self.noise_prior;
+        self.walk(x, true, false, |v| {
+            let ch = v.channel;
+            let m = ch.observed.len();
+            let inv_var = v.inv_var;
+            let sigma = v.log_sigma.exp();
+            // d²/ds² of −[log p(σ) + s] at σ = e^s for InvGamma(α, β): β/σ.
+            let prior_curv = match noise_prior {
+                Prior::InverseGamma { scale, .. } => scale / sigma,
+                _ => 0.0,
+            };
+            metric[(ch.log_sigma_index, ch.log_sigma_index)] += 2.0 * m as f64 + prior_curv;
+            for k in 0..p {
+                let jk = v.sensitivities(k);
+                for l in 0..=k {
+                    let value = inv_var * dot(jk, v.sensitivities(l)) * priors[k].dx * priors[l].dx;
+                    metric[(k, l)] += value;
+                    if l != k {
+                        metric[(l, k)] += value;
                     }
                 }
             }
-        }
-        Ok(())
+            if let Some(d) = &ch.discrepancy {
+                let n = d.priors.len();
+                for j in 0..n {
+                    let bj = d.basis.column(j);
+                    for k in 0..p {
+                        let value = inv_var * dot(v.sensitivities(k), bj.as_slice()) * priors[k].dx;
+                        metric[(k, d.offset + j)] += value;
+                        metric[(d.offset + j, k)] += value;
+                    }
+                    for i in 0..n {
+                        metric[(d.offset + i, d.offset + j)] += inv_var * d.gram[(i, j)];
+                    }
+                    metric[(d.offset + j, d.offset + j)] += d.priors[j].curvature(x[d.offset + j]);
+                }
+            }
+        })
     }
 
     /// The metric with the noise-scale rows made exact: −∂²log π/∂s² = 2·SS/σ² (not its
@@ -708,31 +743,26 @@ impl FisherMetric for CalibrationPosterior {
             DensityError::recoverable("the information is undefined outside the support")
         })?;
         let mut pull = vec![0.0; p];
-        for term in &mut self.records {
-            for c in 0..term.channels.len() {
-                term.residual(c, x);
-                let ch = &term.channels[c];
-                let m = ch.observed.len();
-                let si = ch.log_sigma_index;
-                let inv_var = (-2.0 * x[si]).exp();
-                let ss: f64 = term.residual.iter().map(|r| r * r).sum();
-                out[(si, si)] += 2.0 * ss * inv_var - 2.0 * m as f64;
-                for k in 0..p {
-                    let jr = dot(term.sensitivities(k, c), &term.residual);
-                    pull[k] += inv_var * jr;
-                    let v = 2.0 * inv_var * jr * priors[k].dx;
-                    out[(si, k)] += v;
-                    out[(k, si)] += v;
-                }
-                if let Some(d) = &ch.discrepancy {
-                    for j in 0..d.priors.len() {
-                        let v = 2.0 * inv_var * dot(column_rows(&d.basis, j, 0..m), &term.residual);
-                        out[(si, d.offset + j)] += v;
-                        out[(d.offset + j, si)] += v;
-                    }
+        self.walk(x, true, true, |v| {
+            let si = v.channel.log_sigma_index;
+            let (m, inv_var, residual) = (v.residual.len(), v.inv_var, v.residual);
+            let ss: f64 = residual.iter().map(|r| r * r).sum();
+            out[(si, si)] += 2.0 * ss * inv_var - 2.0 * m as f64;
+            for k in 0..p {
+                let jr = dot(v.sensitivities(k), residual);
+                pull[k] += inv_var * jr;
+                let value = 2.0 * inv_var * jr * priors[k].dx;
+                out[(si, k)] += value;
+                out[(k, si)] += value;
+            }
+            if let Some(d) = &v.channel.discrepancy {
+                for j in 0..d.priors.len() {
+                    let value = 2.0 * inv_var * dot(column_rows(&d.basis, j, 0..m), residual);
+                    out[(si, d.offset + j)] += value;
+                    out[(d.offset + j, si)] += value;
                 }
             }
-        }
+        })?;
         for (k, t) in self.theta.iter().enumerate() {
             if t.transform != Transform::Identity {
                 out[(k, k)] += priors[k].curvature - priors[k].metric - pull[k] * priors[k].d2x;
