@@ -306,3 +306,31 @@ fn fit_takes_several_recordings_and_a_schema_2_model() {
         "basis none is BM1"
     );
 }
+
+#[test]
+fn simulate_takes_a_schema_2_truth_with_terms() {
+    let dir = scratch("truth2");
+    let truth = dir.join("truth-in.toml");
+    std::fs::write(
+        &truth,
+        "schema = 2\n[terms.coulomb_friction]\nT_c = 0.2\n[terms.current_offset]\nb_I = 5.0\n",
+    )
+    .unwrap();
+    let run = |out: &Path, truth: Option<&Path>| {
+        let mut args = vec!["simulate", "--out", out.to_str().unwrap(), "--seed", "5"];
+        if let Some(t) = truth {
+            args.extend(["--truth", t.to_str().unwrap()]);
+        }
+        let o = motorcal(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        std::fs::read_to_string(out.join("recording.csv")).unwrap()
+    };
+    let with = run(&dir.join("with"), Some(&truth));
+    let plain = dir.join("plain.toml");
+    std::fs::write(&plain, "schema = 2\n").unwrap();
+    let without = run(&dir.join("without"), Some(&plain));
+    assert_ne!(with, without, "the terms change the recording");
+    // The truth is written back with its terms.
+    let back = std::fs::read_to_string(dir.join("with/truth.toml")).unwrap();
+    assert!(back.contains("[terms.coulomb_friction]") && back.contains("T_c = 0.2"));
+}

@@ -296,6 +296,7 @@ impl MotorModel {
         }
         MotorSystem {
             model: self,
+            plain: self.terms.is_empty(),
             p,
             coefficients,
             segments,
@@ -386,6 +387,9 @@ pub struct Segments {
 /// A model at fixed parameters: what the integrator sees.
 pub struct MotorSystem<'a, D> {
     model: &'a MotorModel,
+    /// Whether any term is on, read once per solve rather than through the model at every
+    /// evaluation of the right-hand side.
+    plain: bool,
     p: &'a [D],
     coefficients: Coefficients<D>,
     segments: &'a Segments,
@@ -395,7 +399,6 @@ impl<D: Scalar> MotorSystem<'_, D> {
     /// Equations (3)–(4) with every term's contribution: L dI/dt = U − R I − c_m ω + Σ voltage
     /// and J dω/dt = c_g I − d ω + Σ torque (the load torque opposes motion; the paper writes
     /// +T_L but only ever uses T_L = 0).
-    #[inline]
     fn with_terms(&self, t: f64, segment: usize, voltage: D, y: &[D], dy: &mut [D]) {
         let model = self.model;
         let c = &self.coefficients;
@@ -453,7 +456,7 @@ impl<D: Scalar> OdeSystem<D> for MotorSystem<'_, D> {
             Some(&u) => D::from(u),
             None => self.p[MotorParam::Voltage as usize],
         };
-        if !self.model.terms.is_empty() {
+        if !self.plain {
             return self.with_terms(t, segment, voltage, y, dy);
         }
         // The paper's motor alone, as a straight line of arithmetic: this runs six times a step.
