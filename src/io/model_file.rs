@@ -313,6 +313,17 @@ mod tests {
         parse_model_file(text, Path::new("m.toml"))
     }
 
+    /// Each text fails with one line naming this line, this key and this message.
+    fn assert_errors(cases: &[(&str, usize, &str, &str)]) {
+        for &(text, line, field, message) in cases {
+            let e = parse(text).unwrap_err();
+            assert_eq!(e.line, Some(line), "{text:?}: {e}");
+            assert_eq!(e.field.as_deref(), Some(field), "{text:?}: {e}");
+            assert!(e.message.contains(message), "{text:?}: {e}");
+            assert!(!e.to_string().contains('\n'));
+        }
+    }
+
     #[test]
     fn missing_keys_and_tables_take_defaults() {
         assert_eq!(parse("").unwrap(), ModelFile::default());
@@ -368,13 +379,7 @@ mod tests {
                 "unknown field",
             ),
         ];
-        for (text, line, field, message) in cases {
-            let e = parse(text).unwrap_err();
-            assert_eq!(e.line, Some(line), "{text:?}: {e}");
-            assert_eq!(e.field.as_deref(), Some(field), "{text:?}: {e}");
-            assert!(e.message.contains(message), "{text:?}: {e}");
-            assert!(!e.to_string().contains('\n'));
-        }
+        assert_errors(&cases);
         let e = parse("[motor\nR = 1\n").unwrap_err();
         assert_eq!(e.line, Some(1), "{e}");
     }
@@ -450,13 +455,7 @@ mod tests {
                 "larger than",
             ),
         ];
-        for (text, line, field, message) in cases {
-            let e = parse(text).unwrap_err();
-            assert_eq!(e.line, Some(line), "{text:?}: {e}");
-            assert_eq!(e.field.as_deref(), Some(field), "{text:?}: {e}");
-            assert!(e.message.contains(message), "{text:?}: {e}");
-            assert!(!e.to_string().contains('\n'));
-        }
+        assert_errors(&cases);
     }
 
     #[test]

@@ -1,6 +1,6 @@
 //! A back-EMF constant off by a factor: c_m → c_m·(1 + k).
 
-use super::{Coefficients, PhysicsTerm, TermParam, real, relative_prior};
+use super::{Coefficients, PhysicsTerm, TermParam, relative_param};
 use crate::motor::Scalar;
 
 #[derive(Clone, Debug, PartialEq)]
@@ -9,13 +9,7 @@ pub struct BackEmfConstant;
 impl PhysicsTerm for BackEmfConstant {
     const NAME: &'static str = "back_emf_constant";
     const EQUATION: &'static str = "c_m → c_m·(1 + k)";
-    const PARAMS: &'static [TermParam] = &[TermParam {
-        key: "k",
-        unit: "1",
-        default: 0.0,
-        support: real,
-        prior: relative_prior,
-    }];
+    const PARAMS: &'static [TermParam] = &[relative_param("k")];
 
     fn with_settings(_: &[f64]) -> Result<Self, String> {
         Ok(Self)

@@ -180,6 +180,17 @@ pub(crate) fn positive_setting(term: &str, key: &str, v: f64) -> Result<f64, Str
     }
 }
 
+/// A relative change of a constant (a factor 1 + k), dimensionless and of either sign.
+pub(crate) const fn relative_param(key: &'static str) -> TermParam {
+    TermParam {
+        key,
+        unit: "1",
+        default: 0.0,
+        support: real,
+        prior: relative_prior,
+    }
+}
+
 /// The default prior of a relative change (a factor 1 + k): one sd is a tenth.
 pub(crate) fn relative_prior(_: &Magnitudes) -> Prior {
     Prior::Normal {

@@ -1,6 +1,6 @@
 //! A speed sensor with a gain error: measured ω = (1 + g)·ω.
 
-use super::{PhysicsTerm, TermParam, real, relative_prior};
+use super::{PhysicsTerm, TermParam, relative_param};
 use crate::motor::Scalar;
 
 #[derive(Clone, Debug, PartialEq)]
@@ -9,13 +9,7 @@ pub struct SpeedGain;
 impl PhysicsTerm for SpeedGain {
     const NAME: &'static str = "speed_gain";
     const EQUATION: &'static str = "measured ω = (1 + g)·ω";
-    const PARAMS: &'static [TermParam] = &[TermParam {
-        key: "g",
-        unit: "1",
-        default: 0.0,
-        support: real,
-        prior: relative_prior,
-    }];
+    const PARAMS: &'static [TermParam] = &[relative_param("g")];
 
     fn with_settings(_: &[f64]) -> Result<Self, String> {
         Ok(Self)

@@ -1,6 +1,6 @@
 //! A torque constant off by a factor: c_g → c_g·(1 + k) (the paper's φ = 0.9 is k = 1/9).
 
-use super::{Coefficients, PhysicsTerm, TermParam, real, relative_prior};
+use super::{Coefficients, PhysicsTerm, TermParam, relative_param};
 use crate::motor::Scalar;
 
 #[derive(Clone, Debug, PartialEq)]
@@ -9,13 +9,7 @@ pub struct TorqueConstant;
 impl PhysicsTerm for TorqueConstant {
     const NAME: &'static str = "torque_constant";
     const EQUATION: &'static str = "c_g → c_g·(1 + k)";
-    const PARAMS: &'static [TermParam] = &[TermParam {
-        key: "k",
-        unit: "1",
-        default: 0.0,
-        support: real,
-        prior: relative_prior,
-    }];
+    const PARAMS: &'static [TermParam] = &[relative_param("k")];
 
     fn with_settings(_: &[f64]) -> Result<Self, String> {
         Ok(Self)
