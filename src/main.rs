@@ -71,27 +71,40 @@ enum Reproduce {
 
 #[derive(clap::Args)]
 struct Table1Args {
-    /// Seed of the synthetic noise and of the chains.
-    #[arg(long, default_value_t = motorcal::synthetic::DEFAULT_SEED)]
-    seed: u64,
     /// BM2 runs of 10000 instead of 100000 draws.
     #[arg(long)]
     quick: bool,
     /// Samplers to run, comma separated.
     #[arg(long, value_enum, value_delimiter = ',', default_values_t = [app::run::SamplerKind::Metropolis, app::run::SamplerKind::AdaptiveMetropolis, app::run::SamplerKind::NutsDense])]
     samplers: Vec<app::run::SamplerKind>,
-    /// Chains per run.
-    #[arg(long, default_value_t = 3)]
-    chains: usize,
+    #[command(flatten)]
+    chains: ChainArgs,
     /// Worker threads (default: all cores); draws do not depend on it.
     #[arg(long)]
     threads: Option<usize>,
     /// Output folder for draws, table1.json and table1.csv.
     #[arg(long, default_value = "out/table1")]
     out: PathBuf,
+}
+
+/// What every command that runs chains takes: how many, from which seed, shown or not.
+#[derive(clap::Args, Clone)]
+struct ChainArgs {
+    /// Chains per run (default 4; `reproduce table1`: 3, as the paper ran).
+    #[arg(long)]
+    chains: Option<usize>,
+    /// Seed of the chains (and of the paper's synthetic noise).
+    #[arg(long, default_value_t = motorcal::synthetic::DEFAULT_SEED)]
+    seed: u64,
     /// No progress bars.
     #[arg(long)]
     quiet: bool,
+}
+
+impl ChainArgs {
+    fn chains_or(&self, default: usize) -> usize {
+        self.chains.unwrap_or(default)
+    }
 }
 
 #[derive(clap::Args)]
@@ -126,13 +139,13 @@ struct FitArgs {
     out: PathBuf,
 }
 
-/// Options shared by every command that samples.
+/// Options of a command that runs one sampler.
 #[derive(clap::Args, Clone)]
 struct RunArgs {
     #[arg(long, value_enum, default_value_t = app::run::SamplerKind::NutsDense)]
     sampler: app::run::SamplerKind,
-    #[arg(long, default_value_t = 4)]
-    chains: usize,
+    #[command(flatten)]
+    chains: ChainArgs,
     #[arg(long, default_value_t = 1000)]
     warmup: usize,
     #[arg(long, default_value_t = 1000)]
@@ -140,14 +153,9 @@ struct RunArgs {
     /// Keep only the last N draws of each chain.
     #[arg(long)]
     keep: Option<usize>,
-    #[arg(long, default_value_t = motorcal::synthetic::DEFAULT_SEED)]
-    seed: u64,
     /// Worker threads (default: all cores); draws do not depend on it.
     #[arg(long)]
     threads: Option<usize>,
-    /// No progress bars.
-    #[arg(long)]
-    quiet: bool,
     /// HMC/NUTS: save the adapted step size and metric (TOML) for a later warm start.
     #[arg(long)]
     save_adaptation: Option<PathBuf>,
@@ -160,15 +168,15 @@ impl RunArgs {
     fn settings(&self) -> app::run::RunSettings {
         app::run::RunSettings {
             sampler: self.sampler,
-            chains: self.chains,
+            chains: self.chains.chains_or(4),
             chain: motorcal::sampler::ChainSettings {
                 warmup: self.warmup,
                 draws: self.draws,
                 keep: self.keep,
             },
-            seed: self.seed,
+            seed: self.chains.seed,
             threads: self.threads,
-            quiet: self.quiet,
+            quiet: self.chains.quiet,
             save_adaptation: self.save_adaptation.clone(),
             load_adaptation: self.load_adaptation.clone(),
             ..app::run::RunSettings::default()
@@ -203,18 +211,17 @@ struct BenchArgs {
     /// Samplers, comma separated (default: all).
     #[arg(long, value_enum, value_delimiter = ',')]
     samplers: Vec<app::run::SamplerKind>,
-    /// Thread counts, comma separated (default: 1 and all cores).
+    /// Thread counts, comma separated (default: 1 and all cores): the bench measures each, so
+    /// unlike the other commands it takes a list.
     #[arg(long, value_delimiter = ',')]
     threads: Vec<usize>,
-    #[arg(long, default_value_t = 4)]
-    chains: usize,
+    #[command(flatten)]
+    chains: ChainArgs,
     /// Draws per chain (default: per sampler, extended until converged).
     #[arg(long)]
     draws: Option<usize>,
     #[arg(long)]
     warmup: Option<usize>,
-    #[arg(long, default_value_t = motorcal::synthetic::DEFAULT_SEED)]
-    seed: u64,
     /// A recording to bench on instead of the paper's data (with --model).
     #[arg(long)]
     data: Option<PathBuf>,
@@ -225,8 +232,6 @@ struct BenchArgs {
     /// Write the records as JSON here (default: OUT/bench.json).
     #[arg(long)]
     json: Option<PathBuf>,
-    #[arg(long)]
-    quiet: bool,
     /// Redraw the table, CSV and figures from an earlier run's bench.json (no measuring).
     #[arg(long)]
     from_json: Option<PathBuf>,
@@ -246,15 +251,15 @@ fn bench(args: BenchArgs) -> Result<(), AppError> {
         } else {
             args.threads
         },
-        chains: args.chains,
+        chains: args.chains.chains_or(defaults.chains),
         draws: args.draws,
         warmup: args.warmup,
-        seed: args.seed,
+        seed: args.chains.seed,
         data: args.data,
         model: args.model,
         out: args.out,
         json: args.json,
-        quiet: args.quiet,
+        quiet: args.chains.quiet,
         from_json: args.from_json,
     };
     let records = app::bench::bench(&options)?;
@@ -268,13 +273,15 @@ fn bench(args: BenchArgs) -> Result<(), AppError> {
 
 fn table1(args: Table1Args) -> Result<(), AppError> {
     run_table1(app::table1::Table1Options {
-        seed: args.seed,
+        seed: args.chains.seed,
         quick: args.quick,
         samplers: args.samplers,
-        chains: args.chains,
+        chains: args
+            .chains
+            .chains_or(app::table1::Table1Options::default().chains),
         threads: args.threads,
         out: args.out,
-        quiet: args.quiet,
+        quiet: args.chains.quiet,
     })
 }
 

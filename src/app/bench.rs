@@ -205,15 +205,11 @@ pub fn bench(options: &BenchOptions) -> Result<Vec<BenchRecord>, AppError> {
             "bench: name at least one K, sampler and thread count".into(),
         ));
     }
-    if let Some(&k) = options
-        .ks
-        .iter()
-        .find(|&&k| k > crate::bayes::basis::MAX_LEGENDRE_DEGREE)
-    {
-        return Err(AppError::Usage(format!(
-            "--k {k}: the discrepancy degree must be at most {}",
-            crate::bayes::basis::MAX_LEGENDRE_DEGREE
-        )));
+    // Every K is checked up front, by the settings' own rule, before any measuring starts.
+    for &k in &options.ks {
+        ModelSettings::bm2(k)
+            .validate()
+            .map_err(|e| AppError::Usage(format!("--k {k}: {e}")))?;
     }
     if options.threads.contains(&0) || options.chains == 0 {
         return Err(AppError::Usage(
