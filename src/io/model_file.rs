@@ -13,7 +13,7 @@ use super::model_tables::{
     parse_terms, toml_number, write_tables,
 };
 use super::recording::ChannelMap;
-use crate::motor::{ActiveTerm, MotorModel, MotorParam, MotorParameters, VoltageInput};
+use crate::motor::{ActiveTerm, Base, MotorModel, MotorParam, MotorParameters, VoltageInput};
 
 /// The newest model-file format version this build reads and writes. Schema 1 (the motor and
 /// the channels) is still read, and means what it always meant.
@@ -24,6 +24,8 @@ pub const MODEL_FILE_SCHEMA: u32 = 2;
 #[derive(Clone, Debug, PartialEq)]
 pub struct ModelFile {
     pub schema: u32,
+    /// The physics the terms are added to (`base = "voltage_driven"`, the paper's motor).
+    pub base: Base,
     pub motor: MotorParameters,
     /// `[terms.NAME]`, in the canonical order of [`crate::motor::Term::NAMES`].
     pub terms: Vec<ActiveTerm>,
@@ -39,6 +41,7 @@ impl Default for ModelFile {
     fn default() -> Self {
         Self {
             schema: 1,
+            base: Base::VoltageDriven,
             motor: MotorParameters::default(),
             terms: Vec::new(),
             calibrate: None,
@@ -51,12 +54,15 @@ impl Default for ModelFile {
 impl ModelFile {
     /// The model driven by `input`, with the file's terms switched on.
     pub fn model(&self, input: VoltageInput) -> Result<MotorModel, String> {
-        MotorModel::with_terms(self.motor.clone(), input, self.terms.clone())
+        MotorModel::with_base(self.base, self.motor.clone(), input, self.terms.clone())
     }
 
     /// Whether anything needs schema 2 to be written.
     fn needs_schema_2(&self) -> bool {
-        !self.terms.is_empty() || self.calibrate.is_some() || self.discrepancy.is_some()
+        !self.terms.is_empty()
+            || self.calibrate.is_some()
+            || self.discrepancy.is_some()
+            || self.base != Base::VoltageDriven
     }
 }
 
@@ -67,6 +73,7 @@ impl ModelFile {
 struct RawModelFile {
     #[serde(default = "schema_1")]
     schema: u32,
+    base: Option<String>,
     #[serde(default)]
     motor: MotorParameters,
     terms: Option<toml::Table>,
@@ -134,6 +141,7 @@ pub fn parse_model_file(text: &str, path: &Path) -> Result<ModelFile, InputError
     }
     if raw.schema == 1 {
         for (table, present) in [
+            ("base", raw.base.is_some()),
             ("terms", raw.terms.is_some()),
             ("calibrate", raw.calibrate.is_some()),
             ("discrepancy", raw.discrepancy.is_some()),
@@ -148,6 +156,20 @@ pub fn parse_model_file(text: &str, path: &Path) -> Result<ModelFile, InputError
             }
         }
     }
+    let base = match raw.base.as_deref() {
+        None => Base::VoltageDriven,
+        Some(name) => Base::from_name(name).ok_or_else(|| {
+            InputError::new(
+                path,
+                format!(
+                    "unknown base model '{name}' (known: {})",
+                    Base::ALL.map(|b| b.name()).join(", ")
+                ),
+            )
+            .at_line_opt(line_of("base"))
+            .for_field("base")
+        })?,
+    };
     let mut terms = match &raw.terms {
         Some(table) => parse_terms(table, path, &line_of)?,
         None => Vec::new(),
@@ -163,6 +185,7 @@ pub fn parse_model_file(text: &str, path: &Path) -> Result<ModelFile, InputError
     terms.sort_by_key(|t| t.term.rank());
     let model = ModelFile {
         schema: raw.schema,
+        base,
         motor: raw.motor,
         terms,
         calibrate,
@@ -196,7 +219,11 @@ pub fn parse_model_file(text: &str, path: &Path) -> Result<ModelFile, InputError
 /// schema 1 when nothing needs more, so that plain files stay readable by older versions.
 pub fn to_toml_string(model: &ModelFile) -> String {
     let schema = if model.needs_schema_2() { 2 } else { 1 };
-    let mut out = format!("schema = {schema}\n\n[motor]\n");
+    let mut out = format!("schema = {schema}\n");
+    if schema == 2 {
+        out.push_str(&format!("base = \"{}\"\n", model.base.name()));
+    }
+    out.push_str("\n[motor]\n");
     for p in MotorParam::ALL {
         out.push_str(&format!(
             "{} = {}\n",
@@ -447,6 +474,12 @@ mod tests {
                 3,
                 "discrepancy.basis",
                 "unknown basis",
+            ),
+            (
+                "schema = 2\nbase = \"current_driven\"\n",
+                2,
+                "base",
+                "unknown base model",
             ),
             (
                 "schema = 2\n[discrepancy]\ndegree = 99\n",

@@ -38,10 +38,16 @@ pub enum Base {
 }
 
 impl Base {
+    pub const ALL: [Base; 1] = [Base::VoltageDriven];
+
     pub fn name(&self) -> &'static str {
         match self {
             Base::VoltageDriven => "voltage_driven",
         }
+    }
+
+    pub fn from_name(name: &str) -> Option<Base> {
+        Base::ALL.into_iter().find(|b| b.name() == name)
     }
 
     pub fn state_names(&self) -> &'static [&'static str] {
@@ -97,6 +103,16 @@ impl MotorModel {
     pub fn with_terms(
         nominal: MotorParameters,
         input: VoltageInput,
+        terms: Vec<ActiveTerm>,
+    ) -> Result<Self, String> {
+        Self::with_base(Base::VoltageDriven, nominal, input, terms)
+    }
+
+    /// A model of the given base with terms.
+    pub fn with_base(
+        base: Base,
+        nominal: MotorParameters,
+        input: VoltageInput,
         mut terms: Vec<ActiveTerm>,
     ) -> Result<Self, String> {
         if nominal.load_torque != 0.0 {
@@ -130,7 +146,6 @@ impl MotorModel {
                 return Err(format!("term {}: value {v} is not finite", t.term.name()));
             }
         }
-        let base = Base::VoltageDriven;
         let mut param_offsets = vec![N_BASE_PARAMS];
         let mut state_offsets = vec![base.state_names().len()];
         for t in &terms {
