@@ -8,10 +8,12 @@
 //! off by orders of magnitude would otherwise leave the chain stuck and its history uninformative.
 
 use nalgebra::DMatrix;
-use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 
-use super::{Adaptation, Info, Kernel, State, proposal_log_density, random_walk_decision};
+use super::{
+    Adaptation, ChainRng, Info, Kernel, State, Transition, proposal_log_density,
+    random_walk_decision,
+};
 use crate::density::{DensityError, LogDensity};
 
 /// The ridge is relative to each coordinate's own variance, i.e. added to the correlation
@@ -152,12 +154,7 @@ impl<P: LogDensity> Kernel<P> for AdaptiveMetropolis {
         })
     }
 
-    fn step(
-        &mut self,
-        density: &mut P,
-        state: &mut State,
-        rng: &mut ChaCha8Rng,
-    ) -> Result<Info, DensityError> {
+    fn step(&mut self, density: &mut P, state: &mut State, rng: &mut ChainRng) -> Transition {
         let d = self.dim();
         if state.x.len() != d {
             return Err(DensityError::fatal(format!(

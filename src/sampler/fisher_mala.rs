@@ -13,14 +13,13 @@
 
 use nalgebra::DMatrix;
 use rand::RngExt;
-use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;
 
 use super::mala::{
     DualAveraging, DualAveragingSettings, Evaluated, check_state, cholesky_in_place, evaluate,
     lower_tr_mul, metropolis,
 };
-use super::{Adaptation, Info, Kernel, State};
+use super::{Adaptation, ChainRng, Info, Kernel, State, Transition};
 use crate::density::{DensityError, FisherMetric};
 
 /// The metric at one point, factored: G = L Lᵀ.
@@ -232,12 +231,7 @@ impl<P: FisherMetric> Kernel<P> for FisherMala {
         Ok(state)
     }
 
-    fn step(
-        &mut self,
-        density: &mut P,
-        state: &mut State,
-        rng: &mut ChaCha8Rng,
-    ) -> Result<Info, DensityError> {
+    fn step(&mut self, density: &mut P, state: &mut State, rng: &mut ChainRng) -> Transition {
         let d = state.x.len();
         self.resize(d);
         check_state(state, d)?;

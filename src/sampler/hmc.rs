@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 
 use super::adapt::{AdaptationState, HamiltonianKernel};
 use super::metric::Metric;
-use super::{Info, Kernel, State};
+use super::{ChainRng, Info, Kernel, State, Transition};
 use crate::density::{DensityError, LogDensity};
 
 /// A point of phase space with what the integrator and the U-turn criterion reuse, so that a
@@ -324,12 +324,7 @@ impl<P: LogDensity> Kernel<P> for Hmc {
         true
     }
 
-    fn step(
-        &mut self,
-        density: &mut P,
-        state: &mut State,
-        rng: &mut ChaCha8Rng,
-    ) -> Result<Info, DensityError> {
+    fn step(&mut self, density: &mut P, state: &mut State, rng: &mut ChainRng) -> Transition {
         prepare_transition(
             density,
             &self.metric,

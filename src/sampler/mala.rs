@@ -15,7 +15,7 @@ use rand_distr::StandardNormal;
 use serde::{Deserialize, Serialize};
 
 pub use super::adapt::{DualAveraging, DualAveragingSettings};
-use super::{Adaptation, Info, Kernel, State};
+use super::{Adaptation, ChainRng, Info, Kernel, State, Transition};
 use crate::density::{DensityError, LogDensity};
 
 /// The inverse mass matrix M⁻¹ of a preconditioned kernel: the proposal covariance up to ε².
@@ -314,12 +314,7 @@ impl<P: LogDensity> Kernel<P> for Mala {
         true
     }
 
-    fn step(
-        &mut self,
-        density: &mut P,
-        state: &mut State,
-        rng: &mut ChaCha8Rng,
-    ) -> Result<Info, DensityError> {
+    fn step(&mut self, density: &mut P, state: &mut State, rng: &mut ChainRng) -> Transition {
         check_state(state, self.dim())?;
         let eps = self.step_size;
         self.factor

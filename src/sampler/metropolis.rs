@@ -10,10 +10,12 @@
 
 use std::ops::Range;
 
-use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 
-use super::{Adaptation, Info, Kernel, State, proposal_log_density, random_walk_decision};
+use super::{
+    Adaptation, ChainRng, Info, Kernel, State, Transition, proposal_log_density,
+    random_walk_decision,
+};
 use crate::density::{DensityError, LogDensity};
 
 /// Variable-at-a-time Gaussian random-walk Metropolis over the density's blocks.
@@ -112,12 +114,7 @@ impl<P: LogDensity> Kernel<P> for Metropolis {
         })
     }
 
-    fn step(
-        &mut self,
-        density: &mut P,
-        state: &mut State,
-        rng: &mut ChaCha8Rng,
-    ) -> Result<Info, DensityError> {
+    fn step(&mut self, density: &mut P, state: &mut State, rng: &mut ChainRng) -> Transition {
         self.check_blocks(state.x.len())?;
         self.proposal.clear();
         self.proposal.extend_from_slice(&state.x);

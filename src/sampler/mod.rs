@@ -73,6 +73,12 @@ impl Info {
     }
 }
 
+/// The random stream of one chain.
+pub type ChainRng = ChaCha8Rng;
+
+/// What a transition returns: its record, or the fatal error that ends the chain.
+pub type Transition = Result<Info, DensityError>;
+
 /// A transition kernel. `step` must leave `state` a valid state of the chain even when the
 /// density fails recoverably (the proposal is then rejected).
 pub trait Kernel<P: LogDensity> {
@@ -99,12 +105,7 @@ pub trait Kernel<P: LogDensity> {
         }
     }
     /// One transition. A fatal density error aborts the chain.
-    fn step(
-        &mut self,
-        density: &mut P,
-        state: &mut State,
-        rng: &mut ChaCha8Rng,
-    ) -> Result<Info, DensityError>;
+    fn step(&mut self, density: &mut P, state: &mut State, rng: &mut ChainRng) -> Transition;
 }
 
 /// Tunes a kernel during warm-up from the transitions it observes; frozen afterwards.

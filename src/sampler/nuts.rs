@@ -15,7 +15,7 @@ use serde::{Deserialize, Serialize};
 use super::adapt::{AdaptationState, HamiltonianKernel};
 use super::hmc::{PhasePoint, energy_after_leapfrog, prepare_transition};
 use super::metric::Metric;
-use super::{Info, Kernel, State};
+use super::{ChainRng, Info, Kernel, State, Transition};
 use crate::density::{DensityError, LogDensity};
 
 /// Depths beyond this would take over a billion leapfrog steps per draw.
@@ -346,12 +346,7 @@ impl<P: LogDensity> Kernel<P> for Nuts {
         true
     }
 
-    fn step(
-        &mut self,
-        density: &mut P,
-        state: &mut State,
-        rng: &mut ChaCha8Rng,
-    ) -> Result<Info, DensityError> {
+    fn step(&mut self, density: &mut P, state: &mut State, rng: &mut ChainRng) -> Transition {
         let w = &mut self.work;
         prepare_transition(
             density,
