@@ -1,7 +1,8 @@
-//! Table 1's draws on schema-1 input are pinned: a short run of each of Table 1's samplers on
-//! the paper's data (BM1 and BM2(K = 9)), with explicit settings, hashed bit for bit. The
-//! pinned values were printed by the code before the model was opened up to physics terms
-//! (commit 1dd483a); a change that moves any draw by one bit fails here.
+//! Draws on schema-1 input are pinned: short runs of Table 1's samplers on the paper's data
+//! (BM1 and BM2(K = 9)) and of every sampler on BM2(K = 3), with explicit settings, hashed bit
+//! for bit. The pinned values were printed by the code before the model was opened up to
+//! physics terms and before the samplers were reshaped (commit 1dd483a); a change that moves
+//! any draw by one bit fails here.
 
 use motorcal::app::problem::Problem;
 use motorcal::app::run::{RunSettings, SamplerKind, run_sampler};
@@ -61,6 +62,33 @@ fn bm2_draws_are_bit_identical_to_the_pinned_run() {
     println!("BM2(K=9) fingerprint {hash:#018x}");
     assert_eq!(hash, PINNED_BM2, "BM2 draws moved: {hash:#018x}");
 }
+
+/// Every sampler, on BM2(K = 3): the kernels, their adaptation and the posterior's metric and
+/// information (MALA, HMC and NUTS start from the MAP Hessian, Fisher-MALA moves with the
+/// metric) all have to keep their bits.
+#[test]
+fn every_samplers_draws_are_bit_identical_to_the_pinned_run() {
+    let moved: Vec<String> = PINNED_ALL
+        .iter()
+        .filter_map(|&(sampler, pinned)| {
+            let hash = fingerprint(&[sampler], &ModelSettings::bm2(3));
+            println!("{} fingerprint {hash:#018x}", sampler.name());
+            (hash != pinned).then(|| format!("{}: {hash:#018x}", sampler.name()))
+        })
+        .collect();
+    assert!(moved.is_empty(), "draws moved: {moved:?}");
+}
+
+const PINNED_ALL: [(SamplerKind, u64); 8] = [
+    (SamplerKind::Metropolis, 0x8dd13f41e93894f5),
+    (SamplerKind::AdaptiveMetropolis, 0xb5ae37a4008585a4),
+    (SamplerKind::Mala, 0xf6ec9e7b4094e578),
+    (SamplerKind::HmcDiag, 0xfad3f8b7b6d1547b),
+    (SamplerKind::HmcDense, 0x3684d0d613a8992e),
+    (SamplerKind::NutsDiag, 0x186bcd67198e4c42),
+    (SamplerKind::NutsDense, 0x4c9919d071c72697),
+    (SamplerKind::FisherMala, 0x609dbd6d86612a8c),
+];
 
 const PINNED_BM1: u64 = 0xae453d56b8fbfa85;
 const PINNED_BM2: u64 = 0x888fcec9d2f96675;

@@ -6,7 +6,8 @@ use motorcal::sampler::adapt::{
     AdaptationSettings, AdaptationState, DualAveraging, DualAveragingSettings, HamiltonianKernel,
     StepSizeAdaptation, WarmupSchedule, WindowedAdaptation,
 };
-use motorcal::sampler::hmc::{Hmc, HmcSettings, PhasePoint, leapfrog};
+use motorcal::sampler::hamiltonian::{PhasePoint, leapfrog};
+use motorcal::sampler::hmc::{Hmc, HmcSettings};
 use motorcal::sampler::metric::{Metric, MetricKind};
 use motorcal::sampler::nuts::{Nuts, NutsSettings};
 use motorcal::sampler::targets::{Gaussian, check_gaussian_moments};

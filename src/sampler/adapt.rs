@@ -11,16 +11,7 @@ use serde::{Deserialize, Serialize};
 use super::metric::{Metric, MetricKind};
 use super::{Adaptation, Info, State};
 
-/// A kernel whose step size and Euclidean metric warm-up can tune.
-pub trait HamiltonianKernel {
-    fn step_size(&self) -> f64;
-    fn step_size_mut(&mut self) -> &mut f64;
-    fn metric(&self) -> &Metric;
-    fn metric_mut(&mut self) -> &mut Metric;
-    /// Whether Stan's step-size heuristic runs before the next transition (it needs the
-    /// density and the random stream, which only a transition has); cleared once it ran.
-    fn search_pending_mut(&mut self) -> &mut bool;
-}
+pub use super::hamiltonian::HamiltonianKernel;
 
 /// What warm-up tuned: enough to resume sampling later without warm-up (with
 /// [`NoAdaptation`](super::NoAdaptation)) or to warm-start another run.

@@ -9,6 +9,7 @@ pub mod adapt;
 pub mod adaptive_metropolis;
 pub mod driver;
 pub mod fisher_mala;
+pub mod hamiltonian;
 pub mod hmc;
 pub mod mala;
 pub mod metric;

@@ -12,8 +12,8 @@ use rand::RngExt;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use super::adapt::{AdaptationState, HamiltonianKernel};
-use super::hmc::{PhasePoint, energy_after_leapfrog, prepare_transition};
+use super::adapt::AdaptationState;
+use super::hamiltonian::{Dynamics, HamiltonianKernel, PhasePoint, energy_after_leapfrog};
 use super::metric::Metric;
 use super::{ChainRng, Info, Kernel, State, Transition};
 use crate::density::{DensityError, LogDensity};
@@ -62,9 +62,7 @@ impl NutsSettings {
 #[derive(Clone, Debug)]
 pub struct Nuts {
     settings: NutsSettings,
-    step_size: f64,
-    metric: Metric,
-    search_pending: bool,
+    dynamics: Dynamics,
     work: Workspace,
 }
 
@@ -76,9 +74,7 @@ impl Nuts {
         let work = Workspace::new(metric.dim(), settings.max_depth as usize);
         Ok(Self {
             settings,
-            step_size: 1.0,
-            metric,
-            search_pending: true,
+            dynamics: Dynamics::new(metric),
             work,
         })
     }
@@ -88,14 +84,9 @@ impl Nuts {
         state: &AdaptationState,
         settings: NutsSettings,
     ) -> Result<Self, String> {
-        Ok(Self::new(state.metric.clone(), settings)?.with_step_size(state.step_size))
-    }
-
-    /// Fixes the step size (no initial search).
-    pub fn with_step_size(mut self, step_size: f64) -> Self {
-        self.step_size = step_size;
-        self.search_pending = false;
-        self
+        let mut kernel = Self::new(state.metric.clone(), settings)?;
+        kernel.dynamics = Dynamics::tuned(state);
+        Ok(kernel)
     }
 
     pub fn settings(&self) -> &NutsSettings {
@@ -104,20 +95,11 @@ impl Nuts {
 }
 
 impl HamiltonianKernel for Nuts {
-    fn step_size(&self) -> f64 {
-        self.step_size
+    fn dynamics(&self) -> &Dynamics {
+        &self.dynamics
     }
-    fn step_size_mut(&mut self) -> &mut f64 {
-        &mut self.step_size
-    }
-    fn metric(&self) -> &Metric {
-        &self.metric
-    }
-    fn metric_mut(&mut self) -> &mut Metric {
-        &mut self.metric
-    }
-    fn search_pending_mut(&mut self) -> &mut bool {
-        &mut self.search_pending
+    fn dynamics_mut(&mut self) -> &mut Dynamics {
+        &mut self.dynamics
     }
 }
 
@@ -339,7 +321,7 @@ fn log_sum_exp(a: f64, b: f64) -> f64 {
 
 impl<P: LogDensity> Kernel<P> for Nuts {
     fn name(&self) -> String {
-        format!("nuts-{}", self.metric.kind().suffix())
+        format!("nuts-{}", self.metric().kind().suffix())
     }
 
     fn uses_gradient(&self) -> bool {
@@ -348,19 +330,12 @@ impl<P: LogDensity> Kernel<P> for Nuts {
 
     fn step(&mut self, density: &mut P, state: &mut State, rng: &mut ChainRng) -> Transition {
         let w = &mut self.work;
-        prepare_transition(
-            density,
-            &self.metric,
-            &mut self.step_size,
-            &mut self.search_pending,
-            state,
-            rng,
-            &mut w.z_fwd,
-        )?;
-        let eps = self.step_size;
+        self.dynamics.prepare(density, state, rng, &mut w.z_fwd)?;
+        let eps = self.dynamics.step_size;
+        let metric = &self.dynamics.metric;
 
         w.z_fwd.load_state(state);
-        w.z_fwd.refresh_momentum(&self.metric, rng);
+        w.z_fwd.refresh_momentum(metric, rng);
         let h0 = w.z_fwd.energy();
         w.z_bck.copy_from(&w.z_fwd);
         w.z_sample.copy_from(&w.z_fwd);
@@ -384,7 +359,7 @@ impl<P: LogDensity> Kernel<P> for Nuts {
 
         let mut trajectory = Trajectory {
             density,
-            metric: &self.metric,
+            metric,
             rng,
             step: eps,
             h0,
