@@ -103,27 +103,53 @@ impl HamiltonianKernel for Nuts {
     }
 }
 
-/// Scratch space of one transition. Names follow the trajectory's layout: `fwd`/`bck` is the
-/// subtree grown forward/backward in time, and the second part which end of that subtree
-/// (`p_fwd_bck` is the momentum at the backward end of the forward subtree). `sharp` is the
-/// velocity M⁻¹p.
+/// One end of the trajectory as it grows in one direction of time: the phase point at its
+/// tip, the momentum and velocity (M⁻¹p, "sharp") at its outer end and at the end that touches
+/// the other side, and Σp over it.
+#[derive(Clone, Debug)]
+struct Side {
+    z: PhasePoint,
+    p_outer: Vec<f64>,
+    sharp_outer: Vec<f64>,
+    p_inner: Vec<f64>,
+    sharp_inner: Vec<f64>,
+    rho: Vec<f64>,
+}
+
+impl Side {
+    fn new(d: usize) -> Self {
+        Self {
+            z: PhasePoint::new(d),
+            p_outer: vec![0.0; d],
+            sharp_outer: vec![0.0; d],
+            p_inner: vec![0.0; d],
+            sharp_inner: vec![0.0; d],
+            rho: vec![0.0; d],
+        }
+    }
+
+    /// Both ends at the side's tip: the trajectory is still the single point it starts at.
+    fn collapse(&mut self) {
+        for buffer in [&mut self.p_outer, &mut self.p_inner] {
+            buffer.copy_from_slice(&self.z.p);
+        }
+        for buffer in [&mut self.sharp_outer, &mut self.sharp_inner] {
+            buffer.copy_from_slice(&self.z.velocity);
+        }
+    }
+}
+
+const FORWARD: usize = 0;
+const BACKWARD: usize = 1;
+
+/// Scratch space of one transition: the forward and backward sides, the draw and the
+/// proposal, Σp over the whole trajectory, and the frames of the recursion.
 #[derive(Clone, Debug)]
 struct Workspace {
-    z_fwd: PhasePoint,
-    z_bck: PhasePoint,
+    sides: [Side; 2],
     z_sample: PhasePoint,
     z_propose: PhasePoint,
-    p_fwd_fwd: Vec<f64>,
-    sharp_fwd_fwd: Vec<f64>,
-    p_fwd_bck: Vec<f64>,
-    sharp_fwd_bck: Vec<f64>,
-    p_bck_fwd: Vec<f64>,
-    sharp_bck_fwd: Vec<f64>,
-    p_bck_bck: Vec<f64>,
-    sharp_bck_bck: Vec<f64>,
     rho: Vec<f64>,
-    rho_fwd: Vec<f64>,
-    rho_bck: Vec<f64>,
     /// `frames[k]` serves a subtree of depth k + 1 (the deepest, max_depth − 1, is the last
     /// doubling); the two halves it merges are built one after the other with `frames[..k]`,
     /// so frames never alias.
@@ -147,21 +173,10 @@ impl Workspace {
     fn new(d: usize, max_depth: usize) -> Self {
         let v = || vec![0.0; d];
         Self {
-            z_fwd: PhasePoint::new(d),
-            z_bck: PhasePoint::new(d),
+            sides: [Side::new(d), Side::new(d)],
             z_sample: PhasePoint::new(d),
             z_propose: PhasePoint::new(d),
-            p_fwd_fwd: v(),
-            sharp_fwd_fwd: v(),
-            p_fwd_bck: v(),
-            sharp_fwd_bck: v(),
-            p_bck_fwd: v(),
-            sharp_bck_fwd: v(),
-            p_bck_bck: v(),
-            sharp_bck_bck: v(),
             rho: v(),
-            rho_fwd: v(),
-            rho_bck: v(),
             frames: (1..max_depth)
                 .map(|_| Frame {
                     rho_init: v(),
@@ -330,32 +345,20 @@ impl<P: LogDensity> Kernel<P> for Nuts {
 
     fn step(&mut self, density: &mut P, state: &mut State, rng: &mut ChainRng) -> Transition {
         let w = &mut self.work;
-        self.dynamics.prepare(density, state, rng, &mut w.z_fwd)?;
+        let start = &mut w.sides[FORWARD].z;
+        self.dynamics.prepare(density, state, rng, start)?;
         let eps = self.dynamics.step_size;
         let metric = &self.dynamics.metric;
 
-        w.z_fwd.load_state(state);
-        w.z_fwd.refresh_momentum(metric, rng);
-        let h0 = w.z_fwd.energy();
-        w.z_bck.copy_from(&w.z_fwd);
-        w.z_sample.copy_from(&w.z_fwd);
-        for buffer in [
-            &mut w.p_fwd_fwd,
-            &mut w.p_fwd_bck,
-            &mut w.p_bck_fwd,
-            &mut w.p_bck_bck,
-            &mut w.rho,
-        ] {
-            buffer.copy_from_slice(&w.z_fwd.p);
-        }
-        for buffer in [
-            &mut w.sharp_fwd_fwd,
-            &mut w.sharp_fwd_bck,
-            &mut w.sharp_bck_fwd,
-            &mut w.sharp_bck_bck,
-        ] {
-            buffer.copy_from_slice(&w.z_fwd.velocity);
-        }
+        start.load_state(state);
+        start.refresh_momentum(metric, rng);
+        let h0 = start.energy();
+        w.z_sample.copy_from(start);
+        w.rho.copy_from_slice(&start.p);
+        let [forward, backward] = &mut w.sides;
+        backward.z.copy_from(&forward.z);
+        forward.collapse();
+        backward.collapse();
 
         let mut trajectory = Trajectory {
             density,
@@ -374,39 +377,33 @@ impl<P: LogDensity> Kernel<P> for Nuts {
         let mut moved = false;
         while depth < self.settings.max_depth {
             let mut log_weight_subtree = f64::NEG_INFINITY;
-            let valid = if trajectory.rng.random::<f64>() > 0.5 {
-                // The old trajectory becomes the backward part; its forward end is where the
-                // new subtree starts.
-                w.rho_bck.copy_from_slice(&w.rho);
-                w.p_bck_fwd.copy_from_slice(&w.p_fwd_fwd);
-                w.sharp_bck_fwd.copy_from_slice(&w.sharp_fwd_fwd);
-                trajectory.step = eps;
-                let out = Subtree {
-                    propose: &mut w.z_propose,
-                    p_beg: &mut w.p_fwd_bck,
-                    sharp_beg: &mut w.sharp_fwd_bck,
-                    p_end: &mut w.p_fwd_fwd,
-                    sharp_end: &mut w.sharp_fwd_fwd,
-                    rho: &mut w.rho_fwd,
-                    log_weight: &mut log_weight_subtree,
-                };
-                trajectory.build_tree(&mut w.frames, &mut w.z_fwd, depth as usize, out)?
+            let direction = if trajectory.rng.random::<f64>() > 0.5 {
+                FORWARD
             } else {
-                w.rho_fwd.copy_from_slice(&w.rho);
-                w.p_fwd_bck.copy_from_slice(&w.p_bck_bck);
-                w.sharp_fwd_bck.copy_from_slice(&w.sharp_bck_bck);
-                trajectory.step = -eps;
-                let out = Subtree {
-                    propose: &mut w.z_propose,
-                    p_beg: &mut w.p_bck_fwd,
-                    sharp_beg: &mut w.sharp_bck_fwd,
-                    p_end: &mut w.p_bck_bck,
-                    sharp_end: &mut w.sharp_bck_bck,
-                    rho: &mut w.rho_bck,
-                    log_weight: &mut log_weight_subtree,
-                };
-                trajectory.build_tree(&mut w.frames, &mut w.z_bck, depth as usize, out)?
+                BACKWARD
             };
+            // The old trajectory becomes the other side; the end of it that faces the
+            // growing side is where the new subtree starts.
+            let [forward, backward] = &mut w.sides;
+            let (grow, other) = if direction == FORWARD {
+                (forward, backward)
+            } else {
+                (backward, forward)
+            };
+            other.rho.copy_from_slice(&w.rho);
+            other.p_inner.copy_from_slice(&grow.p_outer);
+            other.sharp_inner.copy_from_slice(&grow.sharp_outer);
+            trajectory.step = if direction == FORWARD { eps } else { -eps };
+            let out = Subtree {
+                propose: &mut w.z_propose,
+                p_beg: &mut grow.p_inner,
+                sharp_beg: &mut grow.sharp_inner,
+                p_end: &mut grow.p_outer,
+                sharp_end: &mut grow.sharp_outer,
+                rho: &mut grow.rho,
+                log_weight: &mut log_weight_subtree,
+            };
+            let valid = trajectory.build_tree(&mut w.frames, &mut grow.z, depth as usize, out)?;
             if !valid {
                 break;
             }
@@ -422,12 +419,14 @@ impl<P: LogDensity> Kernel<P> for Nuts {
             }
             log_sum_weight = log_sum_exp(log_sum_weight, log_weight_subtree);
 
-            for ((r, b), f) in w.rho.iter_mut().zip(&w.rho_bck).zip(&w.rho_fwd) {
+            let (fwd, bck) = (&w.sides[FORWARD], &w.sides[BACKWARD]);
+            for ((r, b), f) in w.rho.iter_mut().zip(&bck.rho).zip(&fwd.rho) {
                 *r = b + f;
             }
-            let persists = no_u_turn(&w.sharp_bck_bck, &w.sharp_fwd_fwd, &w.rho_bck, &w.rho_fwd)
-                && no_u_turn(&w.sharp_bck_bck, &w.sharp_fwd_bck, &w.rho_bck, &w.p_fwd_bck)
-                && no_u_turn(&w.sharp_bck_fwd, &w.sharp_fwd_fwd, &w.rho_fwd, &w.p_bck_fwd);
+            // The whole trajectory, and each side merged with the first point of the other.
+            let persists = no_u_turn(&bck.sharp_outer, &fwd.sharp_outer, &bck.rho, &fwd.rho)
+                && no_u_turn(&bck.sharp_outer, &fwd.sharp_inner, &bck.rho, &fwd.p_inner)
+                && no_u_turn(&bck.sharp_inner, &fwd.sharp_outer, &fwd.rho, &bck.p_inner);
             if !persists {
                 break;
             }
