@@ -305,34 +305,19 @@ impl WarmupSchedule {
             } else {
                 (init_buffer, term_buffer, base_window)
             };
-        let last = n_warmup - term_buffer - 1;
-        let mut windows = Vec::new();
-        let mut size = base_window;
-        let mut start = init_buffer;
-        let mut end = init_buffer + base_window - 1;
-        loop {
-            windows.push(start..end + 1);
-            if end >= last {
-                break;
-            }
-            start = end + 1;
-            size *= 2;
-            end += size;
-            if end + 2 * size >= n_warmup - term_buffer {
-                end = last;
-            }
+        Self {
+            windows: doubling_windows(init_buffer, n_warmup - term_buffer, base_window, false),
         }
-        Self { windows }
     }
 
-    fn collects(&self, iteration: usize) -> bool {
+    pub(crate) fn collects(&self, iteration: usize) -> bool {
         match (self.windows.first(), self.windows.last()) {
             (Some(first), Some(last)) => first.start <= iteration && iteration < last.end,
             _ => false,
         }
     }
 
-    fn ends_window(&self, iteration: usize) -> bool {
+    pub(crate) fn ends_window(&self, iteration: usize) -> bool {
         self.windows.iter().any(|w| w.end == iteration + 1)
     }
 }
@@ -446,39 +431,91 @@ impl<K: HamiltonianKernel> Adaptation<K> for WindowedAdaptation {
     }
 }
 
-/// Welford's running mean and (co)variance of a window's draws.
-#[derive(Clone, Debug)]
-struct CovarianceEstimator {
-    kind: MetricKind,
+/// Doubling windows `[a, b)` between `start` and `end`: the first `first_size` long, each
+/// next one twice the last, and a window whose successor would not fit stretched to `end`
+/// (Stan's rule). Stan never stretches the first window (`stretch_first = false`); MALA's
+/// fractional schedule does.
+pub fn doubling_windows(
+    start: usize,
+    end: usize,
+    first_size: usize,
+    stretch_first: bool,
+) -> Vec<Range<usize>> {
+    let mut windows = Vec::new();
+    let (mut a, mut size) = (start, first_size);
+    while a < end {
+        let mut b = (a + size).min(end);
+        if (stretch_first || !windows.is_empty()) && b + 2 * size > end {
+            b = end;
+        }
+        windows.push(a..b);
+        a = b;
+        size *= 2;
+    }
+    windows
+}
+
+/// How Welford's M₂ takes a draw's deviation: (x − x̄ₙ)·δ with δ = x − x̄ₙ₋₁, as Stan and MALA
+/// estimate their metrics, or δ·δ·(n−1)/n, which is the same number in exact arithmetic and
+/// symmetric by construction, as Haario's adaptive Metropolis keeps its covariance. The two
+/// round differently, so each sampler keeps its own and with it its draws.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum WelfordForm {
+    #[default]
+    DeviationAfter,
+    ScaledDelta,
+}
+
+/// Welford's running mean and (co)variance, allocation-free after `reset`: the one estimator
+/// every adaptation uses.
+#[derive(Clone, Debug, Default)]
+pub struct Welford {
+    dense: bool,
+    form: WelfordForm,
     n: usize,
     mean: Vec<f64>,
     delta: Vec<f64>,
-    /// Σ (x − x̄_new)(x − x̄_old)ᵀ: the diagonal, or the whole matrix column-major.
+    /// Σ of the deviations' products: the diagonal, or the whole matrix column-major.
     m2: Vec<f64>,
 }
 
-impl CovarianceEstimator {
-    fn new(dim: usize, kind: MetricKind) -> Self {
-        let m2_len = match kind {
-            MetricKind::Diagonal => dim,
-            MetricKind::Dense => dim * dim,
+impl Welford {
+    pub fn new(dim: usize, dense: bool, form: WelfordForm) -> Self {
+        let mut w = Self {
+            dense,
+            form,
+            ..Self::default()
         };
-        Self {
-            kind,
-            n: 0,
-            mean: vec![0.0; dim],
-            delta: vec![0.0; dim],
-            m2: vec![0.0; m2_len],
-        }
+        w.reset_to(dim);
+        w
     }
 
-    fn reset(&mut self) {
+    /// Forgets every draw (the dimension stays).
+    pub fn reset(&mut self) {
+        self.reset_to(self.mean.len());
+    }
+
+    /// Forgets every draw and takes draws of dimension `dim`.
+    pub fn reset_to(&mut self, dim: usize) {
         self.n = 0;
-        self.mean.fill(0.0);
-        self.m2.fill(0.0);
+        self.mean.clear();
+        self.mean.resize(dim, 0.0);
+        self.delta.clear();
+        self.delta.resize(dim, 0.0);
+        self.m2.clear();
+        self.m2
+            .resize(if self.dense { dim * dim } else { dim }, 0.0);
     }
 
-    fn add(&mut self, x: &[f64]) {
+    pub fn count(&self) -> usize {
+        self.n
+    }
+
+    pub fn dim(&self) -> usize {
+        self.mean.len()
+    }
+
+    pub fn add(&mut self, x: &[f64]) {
         self.n += 1;
         let n = self.n as f64;
         for ((d, m), x) in self.delta.iter_mut().zip(self.mean.iter_mut()).zip(x) {
@@ -486,20 +523,78 @@ impl CovarianceEstimator {
             *m += *d / n;
         }
         let d = x.len();
-        match self.kind {
-            MetricKind::Diagonal => {
+        match (self.form, self.dense) {
+            (WelfordForm::DeviationAfter, false) => {
                 for i in 0..d {
                     self.m2[i] += (x[i] - self.mean[i]) * self.delta[i];
                 }
             }
-            MetricKind::Dense => {
+            (WelfordForm::DeviationAfter, true) => {
                 for j in 0..d {
                     for i in 0..d {
                         self.m2[i + j * d] += (x[i] - self.mean[i]) * self.delta[j];
                     }
                 }
             }
+            (WelfordForm::ScaledDelta, dense) => {
+                let shrink = (n - 1.0) / n;
+                for j in 0..d {
+                    let dj = self.delta[j] * shrink;
+                    if dense {
+                        for i in 0..d {
+                            self.m2[i + j * d] += self.delta[i] * dj;
+                        }
+                    } else {
+                        self.m2[j] += self.delta[j] * dj;
+                    }
+                }
+            }
         }
+    }
+
+    /// M₂ of coordinates (i, j) (only i = j when diagonal).
+    pub fn m2(&self, i: usize, j: usize) -> f64 {
+        if self.dense {
+            self.m2[i + j * self.mean.len()]
+        } else {
+            debug_assert_eq!(i, j);
+            self.m2[i]
+        }
+    }
+
+    /// M₂ as a d×d matrix (dense estimators only).
+    pub fn m2_matrix(&self) -> DMatrix<f64> {
+        let d = self.mean.len();
+        DMatrix::from_column_slice(d, d, &self.m2)
+    }
+
+    /// The diagonal of M₂.
+    pub fn m2_diagonal(&self) -> Vec<f64> {
+        (0..self.mean.len()).map(|i| self.m2(i, i)).collect()
+    }
+}
+
+/// The metric a Stan window estimates, regularised toward the metric in use.
+#[derive(Clone, Debug)]
+struct CovarianceEstimator {
+    kind: MetricKind,
+    welford: Welford,
+}
+
+impl CovarianceEstimator {
+    fn new(dim: usize, kind: MetricKind) -> Self {
+        Self {
+            kind,
+            welford: Welford::new(dim, kind == MetricKind::Dense, WelfordForm::DeviationAfter),
+        }
+    }
+
+    fn reset(&mut self) {
+        self.welford.reset();
+    }
+
+    fn add(&mut self, x: &[f64]) {
+        self.welford.add(x);
     }
 
     /// Stan's shrinkage, n/(n+5)·Σ̂ + 5/(n+5)·(prior), with the prior the metric in use
@@ -508,17 +603,17 @@ impl CovarianceEstimator {
     /// size thirty times too small. Shrinking toward the current metric is scale-free, and a
     /// short window (fewer draws than dimensions) cannot make a good warm start singular.
     fn regularised_metric(&self, current: &Metric) -> Result<Metric, String> {
-        if self.n < 2 {
+        if self.welford.count() < 2 {
             return Err("a window needs at least two draws".into());
         }
-        let n = self.n as f64;
+        let n = self.welford.count() as f64;
         let weight = n / ((n + 5.0) * (n - 1.0));
         let prior_weight = 5.0 / (n + 5.0);
-        let d = self.mean.len();
         let prior = current.inverse_mass_matrix();
         match self.kind {
             MetricKind::Diagonal => Metric::diagonal(
-                self.m2
+                self.welford
+                    .m2_diagonal()
                     .iter()
                     .enumerate()
                     .map(|(i, m)| weight * m + prior_weight * prior[(i, i)])
@@ -526,8 +621,7 @@ impl CovarianceEstimator {
             ),
             MetricKind::Dense => {
                 // Welford's sum is symmetric up to rounding, which `Metric::dense` evens out.
-                let m2 = DMatrix::from_column_slice(d, d, &self.m2);
-                Metric::dense(m2 * weight + prior * prior_weight)
+                Metric::dense(self.welford.m2_matrix() * weight + prior * prior_weight)
             }
         }
     }

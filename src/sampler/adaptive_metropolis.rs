@@ -10,6 +10,7 @@
 use nalgebra::DMatrix;
 use rand_distr::{Distribution, StandardNormal};
 
+use super::adapt::{Welford, WelfordForm};
 use super::{
     Adaptation, ChainRng, Info, Kernel, State, Transition, proposal_log_density,
     random_walk_decision,
@@ -259,14 +260,11 @@ impl HaarioSettings {
 #[derive(Clone, Debug, Default)]
 pub struct HaarioAdaptation {
     settings: HaarioSettings,
-    n: usize,
     /// Accepted moves among the recorded states: a covariance from a chain that barely moved
     /// is degenerate, so it is not used until the chain has moved more often than d times.
     moves: usize,
-    mean: Vec<f64>,
-    /// Sum of outer products of deviations (Welford's M₂).
-    m2: DMatrix<f64>,
-    delta: Vec<f64>,
+    /// The recorded states' mean and covariance, in Haario's symmetric Welford form.
+    welford: Welford,
     /// The kernel's covariance when warm-up began.
     initial: Option<DMatrix<f64>>,
 }
@@ -286,50 +284,35 @@ impl HaarioAdaptation {
 
     /// States recorded so far.
     pub fn samples(&self) -> usize {
-        self.n
+        self.welford.count()
     }
 
     /// The sample covariance of the recorded states (divisor n − 1), once there are two.
     pub fn sample_covariance(&self) -> Option<DMatrix<f64>> {
-        (self.n >= 2).then(|| &self.m2 / (self.n - 1) as f64)
+        let n = self.welford.count();
+        (n >= 2).then(|| self.welford.m2_matrix() / (n - 1) as f64)
     }
 
     fn record(&mut self, x: &[f64], accepted: bool) {
         let d = x.len();
-        if self.mean.len() != d {
-            self.mean = vec![0.0; d];
-            self.delta = vec![0.0; d];
-            self.m2 = DMatrix::zeros(d, d);
-            self.n = 0;
+        if self.welford.dim() != d {
+            self.welford = Welford::new(d, true, WelfordForm::ScaledDelta);
             self.moves = 0;
         }
-        self.n += 1;
         self.moves += accepted as usize;
-        let n = self.n as f64;
-        for i in 0..d {
-            self.delta[i] = x[i] - self.mean[i];
-            self.mean[i] += self.delta[i] / n;
-        }
-        // M₂ += δ (x − x̄ₙ)ᵀ; x − x̄ₙ = δ·(n−1)/n, so the update stays symmetric.
-        let shrink = (n - 1.0) / n;
-        for j in 0..d {
-            let dj = self.delta[j] * shrink;
-            for i in 0..d {
-                self.m2[(i, j)] += self.delta[i] * dj;
-            }
-        }
+        self.welford.add(x);
     }
 
     fn update_covariance(&self, kernel: &mut AdaptiveMetropolis) {
         let d = kernel.dim();
-        if self.n < (2 * d).max(20) || self.moves <= d {
+        if self.welford.count() < (2 * d).max(20) || self.moves <= d {
             return;
         }
         if let Some(cov) = self.sample_covariance() {
             let blended = match &self.initial {
                 Some(initial) => {
                     let n0 = self.settings.initial_weight_per_dim * d as f64;
-                    let n = (self.n - 1) as f64;
+                    let n = (self.welford.count() - 1) as f64;
                     (initial * n0 + cov * n) / (n0 + n)
                 }
                 None => cov,

@@ -15,6 +15,7 @@ use rand_distr::StandardNormal;
 use serde::{Deserialize, Serialize};
 
 pub use super::adapt::{DualAveraging, DualAveragingSettings};
+use super::adapt::{Welford, WelfordForm, doubling_windows};
 use super::{Adaptation, ChainRng, Info, Kernel, State, Transition};
 use crate::density::{DensityError, LogDensity};
 
@@ -492,24 +493,15 @@ impl MalaAdaptation {
         let n = n_warmup as f64;
         let start = (self.settings.initial_buffer * n).round() as usize;
         let end = n_warmup - (self.settings.final_buffer * n).round() as usize;
-        let mut size = ((self.settings.first_window * n).round() as usize).max(1);
+        let size = ((self.settings.first_window * n).round() as usize).max(1);
         // Fewer than ~10 draws per window estimate nothing useful.
         if end <= start || end - start < 10 {
             return Vec::new();
         }
-        let mut windows = Vec::new();
-        let mut a = start;
-        while a < end {
-            let mut b = (a + size).min(end);
-            // Stretch a window whose successor would not fit (Stan's rule).
-            if b + 2 * size > end {
-                b = end;
-            }
-            windows.push((a, b));
-            a = b;
-            size *= 2;
-        }
-        windows
+        doubling_windows(start, end, size, true)
+            .into_iter()
+            .map(|w| (w.start, w.end))
+            .collect()
     }
 }
 
@@ -557,58 +549,27 @@ impl Adaptation<Mala> for MalaAdaptation {
     }
 }
 
-/// Welford's running mean and (co)variance, allocation-free after `reset`.
+/// The window's draws, in the toolkit's Welford estimator, and how M⁻¹ is re-estimated.
 #[derive(Clone, Debug, Default)]
 struct CovarianceEstimator {
     kind: PreconditionerAdaptation,
-    n: usize,
-    mean: Vec<f64>,
-    delta: Vec<f64>,
-    /// Sum of squared deviations: d×d (column-major) for dense, d for diagonal.
-    m2: Vec<f64>,
+    welford: Welford,
 }
 
 impl CovarianceEstimator {
     fn reset(&mut self, dim: usize, kind: PreconditionerAdaptation) {
         self.kind = kind;
-        self.n = 0;
-        self.mean.clear();
-        self.mean.resize(dim, 0.0);
-        self.delta.clear();
-        self.delta.resize(dim, 0.0);
-        let len = match kind {
-            PreconditionerAdaptation::Fixed => 0,
-            PreconditionerAdaptation::Diagonal => dim,
-            PreconditionerAdaptation::Dense => dim * dim,
-        };
-        self.m2.clear();
-        self.m2.resize(len, 0.0);
+        // A fixed M⁻¹ estimates nothing: a diagonal estimator of no use costs nothing either.
+        self.welford = Welford::new(
+            dim,
+            kind == PreconditionerAdaptation::Dense,
+            WelfordForm::DeviationAfter,
+        );
     }
 
     fn push(&mut self, x: &[f64]) {
-        self.n += 1;
-        let n = self.n as f64;
-        for ((m, d), &xi) in self.mean.iter_mut().zip(&mut self.delta).zip(x) {
-            *d = xi - *m;
-            *m += *d / n;
-        }
-        // M2 += δ_before ⊗ (x − mean_after)
-        let dim = x.len();
-        match self.kind {
-            PreconditionerAdaptation::Fixed => {}
-            PreconditionerAdaptation::Diagonal => {
-                for i in 0..dim {
-                    self.m2[i] += self.delta[i] * (x[i] - self.mean[i]);
-                }
-            }
-            PreconditionerAdaptation::Dense => {
-                for j in 0..dim {
-                    let after = x[j] - self.mean[j];
-                    for i in 0..dim {
-                        self.m2[j * dim + i] += self.delta[i] * after;
-                    }
-                }
-            }
+        if self.kind != PreconditionerAdaptation::Fixed {
+            self.welford.add(x);
         }
     }
 
@@ -618,11 +579,12 @@ impl CovarianceEstimator {
     /// (Stan's shrinkage toward 10⁻³·I would swamp coordinates whose variance is 10⁻⁸), which
     /// keeps it positive definite even with fewer draws than dimensions.
     fn estimate(&self, previous: &Preconditioner) -> Option<Preconditioner> {
-        if self.n < 3 {
+        let w2 = &self.welford;
+        if w2.count() < 3 {
             return None;
         }
-        let dim = self.mean.len();
-        let n = self.n as f64;
+        let dim = w2.dim();
+        let n = w2.count() as f64;
         let old = previous.diagonal();
         let variance = |i: usize, m2: f64| {
             let v = m2 / (n - 1.0);
@@ -631,18 +593,17 @@ impl CovarianceEstimator {
         match self.kind {
             PreconditionerAdaptation::Fixed => None,
             PreconditionerAdaptation::Diagonal => Some(Preconditioner::Diagonal(
-                (0..dim).map(|i| variance(i, self.m2[i])).collect(),
+                (0..dim).map(|i| variance(i, w2.m2(i, i))).collect(),
             )),
             PreconditionerAdaptation::Dense => {
                 let w = n / (n + 5.0);
-                let diag: Vec<f64> = (0..dim)
-                    .map(|i| variance(i, self.m2[i * dim + i]))
-                    .collect();
+                let diag: Vec<f64> = (0..dim).map(|i| variance(i, w2.m2(i, i))).collect();
                 let cov = DMatrix::from_fn(dim, dim, |i, j| {
                     if i == j {
                         diag[i]
                     } else {
-                        let c = 0.5 * (self.m2[j * dim + i] + self.m2[i * dim + j]) / (n - 1.0);
+                        // M₂ is symmetric up to rounding; the mean of both triangles is.
+                        let c = 0.5 * (w2.m2(j, i) + w2.m2(i, j)) / (n - 1.0);
                         if c.is_finite() { w * c } else { 0.0 }
                     }
                 });
