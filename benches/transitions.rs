@@ -24,7 +24,7 @@ use motorcal::sampler::adaptive_metropolis::{AdaptiveMetropolis, HaarioAdaptatio
 use motorcal::sampler::driver::chain_rng;
 use motorcal::sampler::fisher_mala::{FisherMala, FisherMalaAdaptation};
 use motorcal::sampler::hmc::{Hmc, HmcSettings};
-use motorcal::sampler::mala::{Mala, MalaAdaptation, Preconditioner};
+use motorcal::sampler::mala::{Mala, MalaAdaptation};
 use motorcal::sampler::metric::{Metric, MetricKind};
 use motorcal::sampler::metropolis::{Metropolis, PyMc3Tuning};
 use motorcal::sampler::nuts::{Nuts, NutsSettings};
@@ -187,7 +187,11 @@ fn bench_transitions(c: &mut Criterion) {
         c,
         &setup,
         "mala",
-        Mala::new(Preconditioner::from_hessian(h).expect("kernel"), mala_step).expect("kernel"),
+        Mala::new(
+            Metric::from_precision(h, MetricKind::Dense).expect("kernel"),
+            mala_step,
+        )
+        .expect("kernel"),
         MalaAdaptation::step_size_only(),
     );
     bench_kernel(

@@ -98,7 +98,8 @@ const PINNED_BM2: u64 = 0x888fcec9d2f96675;
 #[test]
 fn mala_with_windowed_preconditioners_is_bit_identical_to_the_pinned_run() {
     use motorcal::sampler::driver::chain_rng;
-    use motorcal::sampler::mala::{Mala, MalaAdaptation, Preconditioner, PreconditionerAdaptation};
+    use motorcal::sampler::mala::{Mala, MalaAdaptation, PreconditionerAdaptation};
+    use motorcal::sampler::metric::{Metric, MetricKind};
     use motorcal::sampler::run_chain;
     use motorcal::sampler::targets::Gaussian;
     let mut hashes = Vec::new();
@@ -107,7 +108,7 @@ fn mala_with_windowed_preconditioners_is_bit_identical_to_the_pinned_run() {
         PreconditionerAdaptation::Dense,
     ] {
         let target = Gaussian::correlated(5, 0.6, 100.0);
-        let kernel = Mala::new(Preconditioner::identity(5), 0.5).unwrap();
+        let kernel = Mala::new(Metric::identity(5, MetricKind::Diagonal), 0.5).unwrap();
         let settings = ChainSettings {
             warmup: 400,
             draws: 200,

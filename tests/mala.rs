@@ -12,8 +12,9 @@ use motorcal::optimize::{MapSettings, find_map};
 use motorcal::sampler::driver::chain_rng;
 use motorcal::sampler::fisher_mala::{FISHER_MALA_TARGET_ACCEPT, FisherMala, FisherMalaAdaptation};
 use motorcal::sampler::mala::{
-    Mala, MalaAdaptation, MalaAdaptationSettings, Preconditioner, PreconditionerAdaptation,
+    Mala, MalaAdaptation, MalaAdaptationSettings, PreconditionerAdaptation,
 };
+use motorcal::sampler::metric::{Metric, MetricKind};
 use motorcal::sampler::targets::{Gaussian, check_gaussian_moments};
 use motorcal::sampler::{ChainOutput, ChainSettings, run_chain, run_chains};
 use nalgebra::DMatrix;
@@ -79,7 +80,7 @@ fn gaussian_inits(target: &Gaussian) -> Vec<Vec<f64>> {
 
 fn run_mala(
     target: &Gaussian,
-    preconditioner: Preconditioner,
+    preconditioner: Metric,
     adaptation: MalaAdaptationSettings,
     settings: &ChainSettings,
     seed: u64,
@@ -128,7 +129,7 @@ fn mala_with_the_exact_covariance_as_preconditioner_recovers_an_ill_conditioned_
     };
     let chains = run_mala(
         &target,
-        Preconditioner::Dense(target.covariance.clone()),
+        Metric::dense(target.covariance.clone()).unwrap(),
         MalaAdaptationSettings::default(),
         &settings,
         11,
@@ -150,7 +151,7 @@ fn mala_learns_a_diagonal_preconditioner_from_the_identity_in_warm_up() {
     };
     let chains = run_mala(
         &target,
-        Preconditioner::identity(8),
+        Metric::identity(8, MetricKind::Diagonal),
         adaptation,
         &settings,
         12,
@@ -177,7 +178,7 @@ fn mala_learns_a_dense_preconditioner_from_the_identity_in_warm_up() {
     };
     let chains = run_mala(
         &target,
-        Preconditioner::identity(8),
+        Metric::identity(8, MetricKind::Diagonal),
         adaptation,
         &settings,
         13,
@@ -419,7 +420,7 @@ const THIN: usize = 20;
 #[test]
 fn mala_draws_match_an_exact_skewed_density_by_chi_square() {
     let target = one_d_target();
-    let kernel = Mala::new(Preconditioner::Diagonal(target.variance()), 1.0).unwrap();
+    let kernel = Mala::new(Metric::Diagonal(target.variance()), 1.0).unwrap();
     let adaptation = MalaAdaptation::step_size_only();
     let mut rng = chain_rng(31, 0);
     let (out, _) = run_chain(
@@ -590,7 +591,7 @@ fn the_same_seed_gives_bit_identical_draws_on_one_or_two_threads() {
         in_pool(threads, || {
             run_mala(
                 &target,
-                Preconditioner::identity(8),
+                Metric::identity(8, MetricKind::Diagonal),
                 adaptation.clone(),
                 &settings,
                 51,

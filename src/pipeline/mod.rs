@@ -21,7 +21,7 @@ use crate::sampler::adaptive_metropolis::{AdaptiveMetropolis, HaarioAdaptation};
 use crate::sampler::driver::chain_rng;
 use crate::sampler::fisher_mala::{FisherMala, FisherMalaAdaptation};
 use crate::sampler::hmc::{Hmc, HmcSettings};
-use crate::sampler::mala::{Mala, MalaAdaptation, Preconditioner};
+use crate::sampler::mala::{Mala, MalaAdaptation};
 use crate::sampler::metric::{Metric, MetricKind};
 use crate::sampler::metropolis::{Metropolis, PyMc3Tuning};
 use crate::sampler::nuts::{Nuts, NutsSettings};
@@ -367,7 +367,7 @@ fn dispatch<P: Fittable>(
             })?))
         }
         SamplerKind::Mala => Ok(outputs(execute(posterior, inits, settings, label, |_| {
-            let preconditioner = Preconditioner::from_hessian(&map.hessian).map_err(fatal)?;
+            let preconditioner = lower_triangle_covariance(&map.hessian).map_err(fatal)?;
             // With the Laplace covariance as preconditioner the target is nearly whitened, where
             // MALA's optimal step is about 1.65·d^(−1/3).
             let step = 1.65 * (map.x.len() as f64).powf(-1.0 / 3.0);
@@ -443,6 +443,24 @@ where
 
 fn outputs<K>(runs: Vec<(ChainOutput, K)>) -> Vec<ChainOutput> {
     runs.into_iter().map(|(o, _)| o).collect()
+}
+
+/// MALA's preconditioner: the Laplace covariance H⁻¹ with its lower triangle mirrored into
+/// the upper. MALA factors the lower triangle (as it always has), and the mirrored matrix is
+/// exactly symmetric, so the metric keeps it as it is; `Metric::from_precision` would average
+/// the two triangles, which differ in the last bit, and move every MALA draw.
+fn lower_triangle_covariance(hessian: &nalgebra::DMatrix<f64>) -> Result<Metric, String> {
+    let mut covariance = hessian
+        .clone()
+        .cholesky()
+        .ok_or("the Hessian is not positive definite")?
+        .inverse();
+    for j in 0..covariance.ncols() {
+        for i in 0..j {
+            covariance[(i, j)] = covariance[(j, i)];
+        }
+    }
+    Metric::dense(covariance)
 }
 
 /// The metric a Hamiltonian sampler starts from: the Laplace covariance (dense) or its

@@ -358,7 +358,8 @@ impl AdaptationSettings {
 
 /// Stan's warm-up: dual averaging throughout, and the metric (diagonal or dense, whichever the
 /// kernel has) re-estimated at the end of each window of [`WarmupSchedule::stan`] from that
-/// window's draws, regularised as Stan does: (n/(n+5))·Σ̂ + 10⁻³·(5/(n+5))·I. After each update
+/// window's draws, shrunk toward the metric in use: (n/(n+5))·Σ̂ + (5/(n+5))·M⁻¹ (Stan shrinks
+/// toward 10⁻³·I instead; see the estimator for why not here). After each update
 /// the kernel searches a new initial step size and dual averaging restarts from it.
 ///
 /// The metric starts from whatever the kernel has (the identity, or e.g.

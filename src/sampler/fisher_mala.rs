@@ -15,9 +15,9 @@ use nalgebra::DMatrix;
 use rand::RngExt;
 use rand_distr::StandardNormal;
 
-use super::mala::{
-    DualAveraging, DualAveragingSettings, Evaluated, check_state, cholesky_in_place, evaluate,
-    lower_tr_mul, metropolis,
+use super::adapt::{DualAveraging, DualAveragingSettings};
+use super::langevin::{
+    Evaluated, check_state, cholesky_in_place, evaluate, lower_tr_mul, metropolis,
 };
 use super::{Adaptation, ChainRng, Info, Kernel, State, Transition};
 use crate::density::{DensityError, FisherMetric};

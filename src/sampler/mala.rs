@@ -10,54 +10,17 @@
 
 use nalgebra::DMatrix;
 use rand::RngExt;
-use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;
 use serde::{Deserialize, Serialize};
 
 pub use super::adapt::{DualAveraging, DualAveragingSettings};
 use super::adapt::{Welford, WelfordForm, doubling_windows};
+use super::langevin::{
+    Evaluated, check_state, cholesky_in_place, evaluate, lower_mul, lower_tr_mul, metropolis,
+};
+use super::metric::Metric;
 use super::{Adaptation, ChainRng, Info, Kernel, State, Transition};
-use crate::density::{DensityError, LogDensity};
-
-/// The inverse mass matrix M⁻¹ of a preconditioned kernel: the proposal covariance up to ε².
-/// A good choice is the posterior covariance, or the inverse of the Hessian at the mode.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Preconditioner {
-    /// Diagonal of M⁻¹ (the marginal variances).
-    Diagonal(Vec<f64>),
-    /// Dense, symmetric positive-definite M⁻¹.
-    Dense(DMatrix<f64>),
-}
-
-impl Preconditioner {
-    pub fn identity(dim: usize) -> Self {
-        Self::Diagonal(vec![1.0; dim])
-    }
-
-    /// M⁻¹ = H⁻¹ for a positive-definite Hessian of −log π (e.g. `MapEstimate::hessian`).
-    pub fn from_hessian(hessian: &DMatrix<f64>) -> Result<Self, String> {
-        let chol = hessian
-            .clone()
-            .cholesky()
-            .ok_or("the Hessian is not positive definite")?;
-        Ok(Self::Dense(chol.inverse()))
-    }
-
-    pub fn dim(&self) -> usize {
-        match self {
-            Self::Diagonal(v) => v.len(),
-            Self::Dense(m) => m.nrows(),
-        }
-    }
-
-    /// The same preconditioner with its off-diagonal part dropped.
-    pub fn diagonal(&self) -> Vec<f64> {
-        match self {
-            Self::Diagonal(v) => v.clone(),
-            Self::Dense(m) => m.diagonal().iter().copied().collect(),
-        }
-    }
-}
+use crate::density::LogDensity;
 
 /// A square root L of M⁻¹ (L Lᵀ = M⁻¹), lower triangular when dense.
 #[derive(Clone, Debug)]
@@ -67,9 +30,11 @@ enum Factor {
 }
 
 impl Factor {
-    fn new(preconditioner: &Preconditioner) -> Result<Self, String> {
-        match preconditioner {
-            Preconditioner::Diagonal(v) => {
+    /// MALA factors M⁻¹ itself rather than taking the metric's factor: its proposals were
+    /// pinned with this factorisation, and a different one rounds differently.
+    fn new(metric: &Metric) -> Result<Self, String> {
+        match metric {
+            Metric::Diagonal(v) => {
                 if let Some((i, bad)) = v
                     .iter()
                     .enumerate()
@@ -81,7 +46,8 @@ impl Factor {
                 }
                 Ok(Self::Diagonal(v.iter().map(|v| v.sqrt()).collect()))
             }
-            Preconditioner::Dense(m) => {
+            Metric::Dense(dense) => {
+                let m = dense.inverse_mass();
                 if !m.is_square() {
                     return Err(format!(
                         "the inverse mass matrix is {}×{}",
@@ -123,115 +89,13 @@ impl Factor {
     }
 }
 
-/// Overwrites the lower triangle of a symmetric matrix with its Cholesky factor and zeroes the
-/// upper one, without allocating. False when the matrix is not (numerically) positive
-/// definite or not finite; the matrix is then garbage.
-pub(crate) fn cholesky_in_place(a: &mut DMatrix<f64>) -> bool {
-    let n = a.nrows();
-    if a.ncols() != n {
-        return false;
-    }
-    for j in 0..n {
-        let mut diag = a[(j, j)];
-        for k in 0..j {
-            diag -= a[(j, k)] * a[(j, k)];
-        }
-        // `!(diag > 0)` also catches NaN.
-        if !(diag > 0.0 && diag.is_finite()) {
-            return false;
-        }
-        let ljj = diag.sqrt();
-        a[(j, j)] = ljj;
-        for i in j + 1..n {
-            let mut v = a[(i, j)];
-            for k in 0..j {
-                v -= a[(i, k)] * a[(j, k)];
-            }
-            a[(i, j)] = v / ljj;
-        }
-        for i in 0..j {
-            a[(i, j)] = 0.0;
-        }
-    }
-    true
-}
-
-/// out = L v for lower-triangular L (column-major: column j contributes v_j L[j.., j]).
-pub(crate) fn lower_mul(l: &DMatrix<f64>, v: &[f64], out: &mut [f64]) {
-    let n = l.nrows();
-    out.fill(0.0);
-    for (j, &vj) in v.iter().enumerate() {
-        let col = &l.as_slice()[j * n..(j + 1) * n];
-        for i in j..n {
-            out[i] += col[i] * vj;
-        }
-    }
-}
-
-/// out = Lᵀ v for lower-triangular L (each entry a dot product with a contiguous column).
-pub(crate) fn lower_tr_mul(l: &DMatrix<f64>, v: &[f64], out: &mut [f64]) {
-    let n = l.nrows();
-    for (j, o) in out.iter_mut().enumerate() {
-        let col = &l.as_slice()[j * n..(j + 1) * n];
-        *o = col[j..].iter().zip(&v[j..]).map(|(a, b)| a * b).sum();
-    }
-}
-
-/// What a proposal's density evaluation said: whether it can be weighed at all.
-pub(crate) enum Evaluated {
-    Finite(f64),
-    /// Outside the support (or a non-finite value or gradient): rejected, not a failure.
-    Outside,
-    /// A recoverable failure: rejected and counted like a divergence.
-    Failed,
-}
-
-pub(crate) fn evaluate<P: LogDensity>(
-    density: &mut P,
-    x: &[f64],
-    gradient: &mut [f64],
-) -> Result<Evaluated, DensityError> {
-    match density.log_density_and_gradient(x, gradient) {
-        Ok(lp) if lp.is_finite() && gradient.iter().all(|g| g.is_finite()) => {
-            Ok(Evaluated::Finite(lp))
-        }
-        Ok(lp) if lp == f64::NEG_INFINITY => Ok(Evaluated::Outside),
-        // +∞, NaN or a non-finite gradient inside the support is a numerical failure.
-        Ok(_) => Ok(Evaluated::Failed),
-        Err(e) if e.recoverable => Ok(Evaluated::Failed),
-        Err(e) => Err(e),
-    }
-}
-
-/// The Metropolis–Hastings decision for a log acceptance ratio: (accept_stat, accepted).
-/// The uniform is drawn whatever happens, so that a rejection never shifts the random stream.
-pub(crate) fn metropolis(log_ratio: f64, rng: &mut ChaCha8Rng) -> (f64, bool) {
-    let u: f64 = rng.random();
-    let accept_stat = if log_ratio.is_nan() {
-        0.0
-    } else {
-        log_ratio.min(0.0).exp()
-    };
-    (accept_stat, u.ln() < log_ratio)
-}
-
-pub(crate) fn check_state(state: &State, dim: usize) -> Result<(), DensityError> {
-    if state.x.len() != dim || state.gradient.len() != dim {
-        return Err(DensityError::fatal(format!(
-            "a state with {} coordinates and {} gradient entries for a kernel of dimension {dim}",
-            state.x.len(),
-            state.gradient.len()
-        )));
-    }
-    Ok(())
-}
-
 /// Preconditioned MALA with a fixed M⁻¹ (fixed during sampling; an adaptation may replace it
 /// during warm-up).
 #[derive(Clone, Debug)]
 pub struct Mala {
     step_size: f64,
-    preconditioner: Preconditioner,
+    /// M⁻¹, the proposal covariance up to ε².
+    preconditioner: Metric,
     factor: Factor,
     noise: Vec<f64>,
     /// Lᵀ∇log π at the current state and at the proposal: the drift in whitened coordinates.
@@ -247,7 +111,7 @@ impl Mala {
     /// A kernel with inverse mass matrix `preconditioner` and step size `step_size` (in the
     /// preconditioner's units: about 1 when M⁻¹ is the posterior covariance in a few
     /// dimensions, shrinking like d^(-1/6)).
-    pub fn new(preconditioner: Preconditioner, step_size: f64) -> Result<Self, String> {
+    pub fn new(preconditioner: Metric, step_size: f64) -> Result<Self, String> {
         if !(step_size > 0.0 && step_size.is_finite()) {
             return Err(format!(
                 "the step size must be positive and finite, not {step_size}"
@@ -281,12 +145,12 @@ impl Mala {
         self.step_size = step_size;
     }
 
-    pub fn preconditioner(&self) -> &Preconditioner {
+    pub fn preconditioner(&self) -> &Metric {
         &self.preconditioner
     }
 
     /// Replaces M⁻¹ (same dimension); the kernel is unchanged on error.
-    pub fn set_preconditioner(&mut self, preconditioner: Preconditioner) -> Result<(), String> {
+    pub fn set_preconditioner(&mut self, preconditioner: Metric) -> Result<(), String> {
         if preconditioner.dim() != self.dim() {
             return Err(format!(
                 "a preconditioner of dimension {} for a kernel of dimension {}",
@@ -578,21 +442,21 @@ impl CovarianceEstimator {
     /// covariance is shrunk toward its own diagonal with weight 5/(n + 5), a scale-free target
     /// (Stan's shrinkage toward 10⁻³·I would swamp coordinates whose variance is 10⁻⁸), which
     /// keeps it positive definite even with fewer draws than dimensions.
-    fn estimate(&self, previous: &Preconditioner) -> Option<Preconditioner> {
+    fn estimate(&self, previous: &Metric) -> Option<Metric> {
         let w2 = &self.welford;
         if w2.count() < 3 {
             return None;
         }
         let dim = w2.dim();
         let n = w2.count() as f64;
-        let old = previous.diagonal();
+        let old = previous.inverse_mass_diagonal();
         let variance = |i: usize, m2: f64| {
             let v = m2 / (n - 1.0);
             if v > 0.0 && v.is_finite() { v } else { old[i] }
         };
         match self.kind {
             PreconditionerAdaptation::Fixed => None,
-            PreconditionerAdaptation::Diagonal => Some(Preconditioner::Diagonal(
+            PreconditionerAdaptation::Diagonal => Some(Metric::Diagonal(
                 (0..dim).map(|i| variance(i, w2.m2(i, i))).collect(),
             )),
             PreconditionerAdaptation::Dense => {
@@ -607,7 +471,9 @@ impl CovarianceEstimator {
                         if c.is_finite() { w * c } else { 0.0 }
                     }
                 });
-                Some(Preconditioner::Dense(cov))
+                // Symmetric by construction, so `Metric::dense` leaves it as it is; one that
+                // is not positive definite keeps the old M⁻¹.
+                Metric::dense(cov).ok()
             }
         }
     }

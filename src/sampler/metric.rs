@@ -153,6 +153,14 @@ impl Metric {
         Metric::from_precision(&information, kind).map_err(DensityError::fatal)
     }
 
+    /// The diagonal of M⁻¹ (the marginal variances).
+    pub fn inverse_mass_diagonal(&self) -> Vec<f64> {
+        match self {
+            Metric::Diagonal(v) => v.clone(),
+            Metric::Dense(d) => d.inverse_mass().diagonal().iter().copied().collect(),
+        }
+    }
+
     pub fn kind(&self) -> MetricKind {
         match self {
             Metric::Diagonal(_) => MetricKind::Diagonal,

@@ -11,6 +11,7 @@ pub mod driver;
 pub mod fisher_mala;
 pub mod hamiltonian;
 pub mod hmc;
+pub mod langevin;
 pub mod mala;
 pub mod metric;
 pub mod metropolis;
