@@ -3,97 +3,10 @@
 //! ESS needs the autocovariance at every lag of every (split) chain; chains can be 40 000 draws
 //! long, so the direct O(n²) sum is out of the question. A radix-2 transform zero-padded to at
 //! least 2n gives the linear (not circular) autocovariance, as ArviZ's `autocov` does with
-//! `next_fast_len(2n)`; only rounding differs.
+//! `next_fast_len(2n)`; only rounding differs. The transform is rustfft's.
 
-use std::f64::consts::PI;
-
-#[derive(Clone, Copy, Debug, Default)]
-struct Complex {
-    re: f64,
-    im: f64,
-}
-
-impl Complex {
-    fn new(re: f64, im: f64) -> Self {
-        Self { re, im }
-    }
-    fn add(self, o: Self) -> Self {
-        Self::new(self.re + o.re, self.im + o.im)
-    }
-    fn sub(self, o: Self) -> Self {
-        Self::new(self.re - o.re, self.im - o.im)
-    }
-    fn mul(self, o: Self) -> Self {
-        Self::new(
-            self.re * o.re - self.im * o.im,
-            self.re * o.im + self.im * o.re,
-        )
-    }
-    fn conj(self) -> Self {
-        Self::new(self.re, -self.im)
-    }
-    fn norm_sqr(self) -> f64 {
-        self.re * self.re + self.im * self.im
-    }
-}
-
-/// Precomputed radix-2 transform of one power-of-two length.
-struct Radix2 {
-    /// e^{-2πik/n} for k < n/2, each from its own sin/cos call: a recurrence would accumulate
-    /// error over 65 536 points.
-    twiddles: Vec<Complex>,
-}
-
-impl Radix2 {
-    fn new(n: usize) -> Self {
-        debug_assert!(n.is_power_of_two());
-        let twiddles = (0..n / 2)
-            .map(|k| {
-                let angle = -2.0 * PI * (k as f64) / (n as f64);
-                Complex::new(angle.cos(), angle.sin())
-            })
-            .collect();
-        Self { twiddles }
-    }
-
-    /// Unnormalised in-place transform; `inverse` flips the sign of the exponent.
-    fn transform(&self, buf: &mut [Complex], inverse: bool) {
-        let n = buf.len();
-        debug_assert_eq!(n, 2 * self.twiddles.len().max(1));
-        if n < 2 {
-            return;
-        }
-        let mut j = 0;
-        for i in 1..n {
-            let mut bit = n >> 1;
-            while j & bit != 0 {
-                j ^= bit;
-                bit >>= 1;
-            }
-            j ^= bit;
-            if i < j {
-                buf.swap(i, j);
-            }
-        }
-        let mut len = 2;
-        while len <= n {
-            let half = len / 2;
-            let stride = n / len;
-            for block in buf.chunks_exact_mut(len) {
-                let (lo, hi) = block.split_at_mut(half);
-                for (k, (a, b)) in lo.iter_mut().zip(hi.iter_mut()).enumerate() {
-                    let w = self.twiddles[k * stride];
-                    let w = if inverse { w.conj() } else { w };
-                    let v = b.mul(w);
-                    let u = *a;
-                    *a = u.add(v);
-                    *b = u.sub(v);
-                }
-            }
-            len <<= 1;
-        }
-    }
-}
+use rustfft::FftPlanner;
+use rustfft::num_complex::Complex;
 
 /// Biased (divisor n) autocovariance at lags 0..n of each row, averaged over rows.
 ///
@@ -107,7 +20,9 @@ pub(super) fn mean_autocovariance(rows: &[&[f64]]) -> Vec<f64> {
         return Vec::new();
     }
     let m = (2 * n).next_power_of_two();
-    let plan = Radix2::new(m);
+    let mut planner = FftPlanner::<f64>::new();
+    let forward = planner.plan_fft_forward(m);
+    let inverse = planner.plan_fft_inverse(m);
     let mut sum = vec![0.0; n];
     let mut buf = vec![Complex::default(); m];
     let mut power = vec![Complex::default(); m];
@@ -122,7 +37,7 @@ pub(super) fn mean_autocovariance(rows: &[&[f64]]) -> Vec<f64> {
             slot.re = a[i] - mean_a;
             slot.im = b.map_or(0.0, |b| b[i] - mean_b);
         }
-        plan.transform(&mut buf, false);
+        forward.process(&mut buf);
         // Untangle the two real spectra, A_k = (Z_k + conj Z_{m-k})/2 and
         // B_k = (Z_k − conj Z_{m-k})/(2i); |A|² and |B|² are even and real, so a single inverse
         // transform of |A|² + i|B|² returns both autocovariances, one per component.
@@ -133,7 +48,7 @@ pub(super) fn mean_autocovariance(rows: &[&[f64]]) -> Vec<f64> {
             let spec_b = Complex::new(0.5 * (z.im - zc.im), -0.5 * (z.re - zc.re));
             power[k] = Complex::new(spec_a.norm_sqr(), spec_b.norm_sqr());
         }
-        plan.transform(&mut power, true);
+        inverse.process(&mut power);
         let scale = 1.0 / (m as f64 * n as f64);
         for (t, s) in sum.iter_mut().enumerate() {
             *s += power[t].re * scale;
