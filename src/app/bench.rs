@@ -408,3 +408,136 @@ fn write_outputs(options: &BenchOptions, records: &[BenchRecord]) -> Result<(), 
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampler::ChainOutput;
+
+    /// A run of `chains` chains, each `sampling_s` seconds of sampling, with these diagnostics.
+    fn run(chains: usize, sampling_s: f64, min_ess: f64, max_rhat: f64) -> RunOutput {
+        let chain = |c: usize| ChainOutput {
+            chain: c,
+            sampler: "x".into(),
+            names: Vec::new(),
+            draws: Vec::new(),
+            unconstrained: Vec::new(),
+            records: Vec::new(),
+            warmup_seconds: 1.0,
+            sampling_seconds: sampling_s,
+            warmup_density_evaluations: 0,
+            warmup_gradient_evaluations: 0,
+            sampling_density_evaluations: 3000,
+            sampling_gradient_evaluations: 2000,
+            uses_gradient: true,
+            divergences: 0,
+            mean_accept_stat: 0.8,
+            final_step_size: 0.1,
+        };
+        RunOutput {
+            sampler: "x".into(),
+            chains: (0..chains).map(chain).collect(),
+            summaries: Vec::new(),
+            max_rhat,
+            min_ess_bulk: min_ess,
+            wall_seconds: 9.0,
+            warmup_seconds: 1.0,
+            sampling_seconds: sampling_s,
+            sampling_density_evaluations: 3000 * chains as u64,
+            sampling_gradient_evaluations: 2000 * chains as u64,
+            divergences: 0,
+            map_log_density: 0.0,
+            log_evidence_laplace: 0.0,
+        }
+    }
+
+    fn settings() -> ChainSettings {
+        ChainSettings {
+            warmup: 100,
+            draws: 400,
+            keep: None,
+        }
+    }
+
+    #[test]
+    fn convergence_needs_both_rhat_and_ess() {
+        assert!(converged(&run(4, 1.0, 100.0, 1.01)));
+        assert!(!converged(&run(4, 1.0, 99.9, 1.0)));
+        assert!(!converged(&run(4, 1.0, 5000.0, 1.011)));
+        assert!(!converged(&run(4, 1.0, f64::NAN, 1.0)));
+    }
+
+    #[test]
+    fn ess_per_second_shares_the_sampling_time_among_the_chains_running_at_once() {
+        // Four chains of 2 s each: on one thread 8 s of wall time, on two threads 4 s, on four
+        // 2 s, and threads beyond one per chain do not help.
+        let r = run(4, 2.0, 800.0, 1.0);
+        let per_s = |threads| record(SamplerKind::NutsDense, 9, threads, 4, &settings(), &r);
+        let one = per_s(1);
+        assert_eq!(one.min_ess_per_s, 100.0);
+        assert_eq!(per_s(2).min_ess_per_s, 200.0);
+        assert_eq!(per_s(4).min_ess_per_s, 400.0);
+        assert_eq!(per_s(8).min_ess_per_s, 400.0);
+        assert_eq!(one.sampling_cpu_s, 8.0);
+        // Gradient samplers are counted per gradient, the others per density evaluation.
+        assert_eq!(one.eval_kind, "gradient");
+        assert_eq!(one.min_ess_per_eval, 800.0 / 8000.0);
+        let metropolis = record(SamplerKind::Metropolis, 9, 1, 4, &settings(), &r);
+        assert_eq!(metropolis.eval_kind, "density");
+        assert_eq!(metropolis.min_ess_per_eval, 800.0 / 12000.0);
+    }
+
+    #[test]
+    fn an_unconverged_run_is_a_bound_and_its_ratios_say_so() {
+        let gradient = record(
+            SamplerKind::NutsDense,
+            9,
+            1,
+            4,
+            &settings(),
+            &run(4, 1.0, 4000.0, 1.002),
+        );
+        let baseline_ok = record(
+            SamplerKind::AdaptiveMetropolis,
+            9,
+            1,
+            4,
+            &settings(),
+            &run(4, 1.0, 200.0, 1.004),
+        );
+        let baseline_bad = BenchRecord {
+            sampler: "metropolis".into(),
+            ..record(
+                SamplerKind::Metropolis,
+                9,
+                1,
+                4,
+                &settings(),
+                &run(4, 1.0, 8.0, 1.4),
+            )
+        };
+        assert!(gradient.converged && !gradient.lower_bound);
+        assert!(!baseline_bad.converged && baseline_bad.lower_bound);
+        let table = format_table(&[gradient.clone(), baseline_ok, baseline_bad]);
+        // 4000/4 = 1000 ESS/s against 200/4 = 50 and 8/4 = 2.
+        assert!(
+            table.contains("nuts-dense / adaptive-metropolis = 20.0×\n"),
+            "{table}"
+        );
+        assert!(
+            table.contains(
+                "nuts-dense / metropolis = ≥ 500.0× (baseline not converged at its longest run)"
+            ),
+            "{table}"
+        );
+        assert!(table.contains("NOT CONVERGED") || table.contains(" no\n"));
+        // Without a converged gradient sampler there is no ratio to print.
+        let unconverged_gradient = BenchRecord {
+            converged: false,
+            lower_bound: true,
+            ..gradient
+        };
+        let table = format_table(&[unconverged_gradient]);
+        assert!(!table.contains('×'), "{table}");
+    }
+}
