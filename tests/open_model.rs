@@ -179,6 +179,17 @@ fn every_term_is_recovered_from_a_recording_where_it_is_clearly_visible() {
         assert!((r.mean - 0.1).abs() <= 3.0 * r.sd, "{name}: R {r:?}");
         for (p, t) in term.params().iter().zip(&truth) {
             let s = summary(&report, &format!("{name}__{}", p.key));
+            println!(
+                "round trip {name}.{}: truth {t:.4e}, posterior {:.4e} ± {:.2e} ({:+.2} sd), \
+                 R {:.5} ± {:.1e}, visible {shown:.1} σ, R-hat {:.4}",
+                p.key,
+                s.mean,
+                s.sd,
+                (s.mean - t) / s.sd,
+                r.mean,
+                r.sd,
+                report.max_rhat.unwrap()
+            );
             assert!(
                 (s.mean - t).abs() <= 3.0 * s.sd,
                 "{name}.{}: posterior {} ± {}, truth {t}",
