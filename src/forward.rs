@@ -195,15 +195,11 @@ impl ForwardModel {
         self.model.initial_state(p, &mut y0);
         let mut states = vec![D::from(0.0); n * m];
         let system = self.model.system(p, &self.segments);
-        let stats = ode::solve(&system, T0, &y0, &self.times, &self.solver, &mut states)?;
-        let mut measured = vec![D::from(0.0); n_channels];
-        for i in 0..m {
-            self.model
-                .measure(&states[i * n..(i + 1) * n], p, &mut measured);
-            for c in 0..n_channels {
-                out[c * m + i] = measured[c];
-            }
-        }
+        let stats = match system.plain() {
+            Ok(plain) => ode::solve(&plain, T0, &y0, &self.times, &self.solver, &mut states)?,
+            Err(system) => ode::solve(&system, T0, &y0, &self.times, &self.solver, &mut states)?,
+        };
+        self.model.measure(&states, p, &mut out[..n_channels * m]);
         Ok(stats)
     }
 }
