@@ -48,6 +48,9 @@ enum Command {
     Fit(FitArgs),
     /// Effective samples per second of every sampler across K, side by side.
     Bench(BenchArgs),
+    /// Find the physics the model left out: locate the mismatch, rank candidate terms by
+    /// evidence, add the best, refit, and show the fit improve.
+    Diagnose(DiagnoseArgs),
     /// Reproduce a result of the paper.
     Reproduce {
         #[command(subcommand)]
@@ -204,6 +207,68 @@ fn fit(args: FitArgs) -> Result<(), AppError> {
 }
 
 #[derive(clap::Args)]
+struct DiagnoseArgs {
+    /// A recording; repeat for several (shared physics, noise per recording).
+    #[arg(long, required = true)]
+    data: Vec<PathBuf>,
+    /// The nominal model (TOML, schema 1 or 2).
+    #[arg(long)]
+    model: PathBuf,
+    /// Degree K of the discrepancy that locates the mismatch (default 9).
+    #[arg(long)]
+    k: Option<usize>,
+    /// Candidate terms, comma separated (default: every term the model lacks).
+    #[arg(long, value_delimiter = ',')]
+    candidates: Option<Vec<String>>,
+    /// Write the report as JSON here.
+    #[arg(long)]
+    json: Option<PathBuf>,
+    /// Write figures, fit.json and the amended model.toml here.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Rank and select only: no sampled fits before and after.
+    #[arg(long)]
+    rank_only: bool,
+    #[command(flatten)]
+    chains: ChainArgs,
+    #[arg(long, default_value_t = 500)]
+    warmup: usize,
+    #[arg(long, default_value_t = 500)]
+    draws: usize,
+}
+
+fn diagnose(args: DiagnoseArgs) -> Result<(), AppError> {
+    let run = app::run::RunSettings {
+        sampler: app::run::SamplerKind::NutsDense,
+        chains: args.chains.chains_or(4),
+        chain: motorcal::sampler::ChainSettings {
+            warmup: args.warmup,
+            draws: args.draws,
+            keep: None,
+        },
+        seed: args.chains.seed,
+        quiet: args.chains.quiet,
+        ..app::run::RunSettings::default()
+    };
+    let options = app::diagnose::DiagnoseOptions {
+        data: args.data,
+        model: args.model,
+        k: args.k,
+        candidates: args.candidates,
+        run,
+        out: args.out,
+        json: args.json,
+        rank_only: args.rank_only,
+    };
+    let diagnosis = app::diagnose::diagnose(&options)?;
+    print!("{}", app::diagnose::format_diagnosis(&diagnosis));
+    for path in &diagnosis.outputs {
+        println!("wrote {path}");
+    }
+    Ok(())
+}
+
+#[derive(clap::Args)]
 struct BenchArgs {
     /// Discrepancy degrees, comma separated.
     #[arg(long, value_delimiter = ',', default_values_t = motorcal::app::bench::DEFAULT_KS)]
@@ -309,6 +374,7 @@ fn run(cli: Cli) -> Result<(), AppError> {
         }) => table1(args),
         Some(Command::Fit(args)) => fit(args),
         Some(Command::Bench(args)) => bench(args),
+        Some(Command::Diagnose(args)) => diagnose(args),
         Some(Command::Simulate {
             truth,
             nominal,

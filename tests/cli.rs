@@ -334,3 +334,48 @@ fn simulate_takes_a_schema_2_truth_with_terms() {
     let back = std::fs::read_to_string(dir.join("with/truth.toml")).unwrap();
     assert!(back.contains("[terms.coulomb_friction]") && back.contains("T_c = 0.2"));
 }
+
+#[test]
+fn diagnose_refuses_bad_input_with_one_line_and_writes_nothing() {
+    let dir = scratch("diagnose-bad");
+    simulate_into(&dir);
+    let data = dir.join("recording.csv");
+    let model = dir.join("motor.toml");
+    let json = dir.join("report.json");
+    let out = dir.join("out");
+    let run = |data: &Path, extra: &[&str]| {
+        let mut args = vec![
+            "diagnose",
+            "--data",
+            data.to_str().unwrap(),
+            "--model",
+            model.to_str().unwrap(),
+            "--json",
+            json.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        motorcal(&args)
+    };
+    assert_clean_failure(
+        &run(&data, &["--candidates", "coulomb_friction,magic"]),
+        &["--candidates", "magic", "coulomb_friction"],
+    );
+    assert_clean_failure(&run(&data, &["--k", "41"]), &["--k 41"]);
+    assert_clean_failure(&run(&data, &["--chains", "0"]), &["--chains 0"]);
+    let short = scratch("diagnose-short");
+    let o = motorcal(&[
+        "simulate",
+        "--out",
+        short.to_str().unwrap(),
+        "--samples",
+        "20",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_clean_failure(
+        &run(&short.join("recording.csv"), &[]),
+        &["recording.csv", "too short"],
+    );
+    assert!(!json.exists() && !out.exists());
+}

@@ -1,0 +1,240 @@
+//! The sampled fits before and after the selected terms: noise, RMSE, log likelihood, the
+//! posterior means of the parameters, residual whiteness (Ljung–Box), convergence, and where
+//! BM2's discrepancy band excludes zero.
+
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+use statrs::distribution::{ChiSquared, ContinuousCDF};
+
+use crate::app::AppError;
+use crate::app::fit::posterior_mean;
+use crate::app::predictive::{Predictive, posterior_predictive};
+use crate::app::problem::Problem;
+use crate::bayes::{CalibrationPosterior, ModelSettings};
+use crate::density::LogDensity;
+use crate::diagnostics::autocovariance;
+use crate::pipeline::{RunOutput, RunSettings, run_sampler};
+
+/// Lags of the Ljung–Box statistic: 20, the usual choice for a few hundred samples, long enough
+/// to see the slow drifts a missing term leaves and short against 501 samples.
+pub const LJUNG_BOX_LAGS: usize = 20;
+
+/// Ljung–Box Q over the first `LJUNG_BOX_LAGS` lags and its p-value under whiteness (χ² with as
+/// many degrees of freedom).
+#[derive(Clone, Debug, Serialize)]
+pub struct Whiteness {
+    pub q: f64,
+    pub lags: usize,
+    pub p_value: f64,
+}
+
+pub fn ljung_box(residual: &[f64]) -> Whiteness {
+    let n = residual.len();
+    let lags = LJUNG_BOX_LAGS.min(n.saturating_sub(2)).max(1);
+    let mean = residual.iter().sum::<f64>() / n as f64;
+    let centred: Vec<f64> = residual.iter().map(|v| v - mean).collect();
+    let acov = autocovariance(&centred);
+    let q = if acov[0] > 0.0 {
+        (1..=lags)
+            .map(|k| (acov[k] / acov[0]).powi(2) / (n - k) as f64)
+            .sum::<f64>()
+            * (n * (n + 2)) as f64
+    } else {
+        0.0
+    };
+    let p_value = ChiSquared::new(lags as f64)
+        .map(|d| 1.0 - d.cdf(q))
+        .unwrap_or(f64::NAN);
+    Whiteness { q, lags, p_value }
+}
+
+/// One sampled BM1 fit, as the report shows it.
+#[derive(Clone, Debug, Serialize)]
+pub struct FitSummary {
+    /// The noise σ per channel (posterior mean), keyed by the recording's column name; with
+    /// several recordings, `column@record`.
+    pub sigma: BTreeMap<String, f64>,
+    /// RMSE of y − G(θ) at the posterior mean, keyed likewise.
+    pub rmse: BTreeMap<String, f64>,
+    /// The log likelihood at the posterior mean.
+    pub log_likelihood: f64,
+    /// Posterior means of the calibrated parameters (physical values).
+    pub params_mean: BTreeMap<String, f64>,
+    /// 95% intervals of the calibrated parameters.
+    pub params_95: BTreeMap<String, [f64; 2]>,
+    pub whiteness: BTreeMap<String, Whiteness>,
+}
+
+/// R-hat, ESS and divergences of one run.
+#[derive(Clone, Debug, Serialize)]
+pub struct Convergence {
+    pub sampler: String,
+    pub max_rhat: f64,
+    pub min_ess_bulk: f64,
+    pub divergences: usize,
+    pub wall_s: f64,
+}
+
+impl Convergence {
+    pub fn of(run: &RunOutput) -> Self {
+        Self {
+            sampler: run.sampler.clone(),
+            max_rhat: run.max_rhat,
+            min_ess_bulk: run.min_ess_bulk,
+            divergences: run.divergences,
+            wall_s: run.wall_seconds,
+        }
+    }
+}
+
+/// A sampled fit and its posterior, for the figures.
+pub struct SampledFit {
+    pub posterior: CalibrationPosterior,
+    pub run: RunOutput,
+}
+
+/// Samples `problem` (a candidate problem: terms on, calibrated) under `settings`.
+pub fn sample(
+    problem: &Problem,
+    settings: &ModelSettings,
+    run: &RunSettings,
+    label: &str,
+) -> Result<SampledFit, AppError> {
+    let mut posterior = problem.posterior(settings)?;
+    let run = run_sampler(&mut posterior, run, label)?;
+    Ok(SampledFit { posterior, run })
+}
+
+/// The recording's own name of a model channel.
+pub fn column_name(problem: &Problem, channel: &str) -> String {
+    let map = &problem.model.channels;
+    match channel {
+        "I" => map.current.clone(),
+        "omega" => map.speed.clone(),
+        other => other.to_string(),
+    }
+}
+
+fn key(problem: &Problem, record: usize, channel: &str) -> String {
+    let column = column_name(problem, channel);
+    if problem.recordings.len() > 1 {
+        format!("{column}@{}", problem.recordings[record].source)
+    } else {
+        column
+    }
+}
+
+pub fn summarize_fit(problem: &Problem, fit: &mut SampledFit) -> Result<FitSummary, AppError> {
+    let mean = posterior_mean(&fit.run);
+    let posterior = &mut fit.posterior;
+    let mut sigma = BTreeMap::new();
+    let mut rmse = BTreeMap::new();
+    let mut whiteness = BTreeMap::new();
+    for r in 0..posterior.n_records() {
+        let residuals = posterior.residuals(&mean, r)?;
+        for (c, name) in posterior.channel_names(r).into_iter().enumerate() {
+            let k = key(problem, r, &name);
+            let res = &residuals[c];
+            rmse.insert(
+                k.clone(),
+                (res.iter().map(|v| v * v).sum::<f64>() / res.len() as f64).sqrt(),
+            );
+            let s = fit
+                .run
+                .summary(&format!("sigma_{}", sigma_suffix(posterior, r, c)))
+                .map(|s| s.mean)
+                .unwrap_or_else(|| mean[posterior.log_sigma_index(r, c)].exp());
+            sigma.insert(k.clone(), s);
+            whiteness.insert(k, ljung_box(res));
+        }
+    }
+    let mut params_mean = BTreeMap::new();
+    let mut params_95 = BTreeMap::new();
+    for c in posterior.calibrated() {
+        if let Some(s) = fit.run.summary(&c.output_name()) {
+            params_mean.insert(c.name.clone(), s.mean);
+            params_95.insert(c.name.clone(), [s.q025, s.q975]);
+        }
+    }
+    Ok(FitSummary {
+        sigma,
+        rmse,
+        log_likelihood: posterior.log_likelihood(&mean)?,
+        params_mean,
+        params_95,
+        whiteness,
+    })
+}
+
+/// The suffix the run's summaries give a channel's σ (`I`, `omega`, or `I_2` for a second
+/// recording), read from the posterior's own names.
+fn sigma_suffix(posterior: &CalibrationPosterior, record: usize, channel: usize) -> String {
+    let names = posterior.parameter_names();
+    names[posterior.log_sigma_index(record, channel)]
+        .trim_start_matches("log_sigma_")
+        .to_string()
+}
+
+/// Where BM2's 95% band of δ excludes zero, per record and channel.
+#[derive(Clone, Debug, Serialize)]
+pub struct Mismatch {
+    pub channel: String,
+    pub t_start: f64,
+    pub t_end: f64,
+    /// The largest |posterior mean of δ| in the interval, over the channel's noise σ.
+    pub max_over_sigma: f64,
+}
+
+/// The share of a record an interval must cover to count as a mismatch when judging whether any
+/// is left: a pointwise 95% band over hundreds of samples excludes zero on a few isolated samples
+/// by chance, a missing effect does so on a stretch.
+pub const MISMATCH_MIN_SHARE: f64 = 0.05;
+
+pub fn mismatches(
+    problem: &Problem,
+    fit: &mut SampledFit,
+) -> Result<(Vec<Mismatch>, Vec<Predictive>), AppError> {
+    let mut out = Vec::new();
+    let mut predictives = Vec::new();
+    for r in 0..fit.posterior.n_records() {
+        let p = posterior_predictive(&mut fit.posterior, &fit.run.chains, r)?;
+        for ch in &p.channels {
+            let mut start: Option<usize> = None;
+            let m = p.times.len();
+            for i in 0..=m {
+                let excludes =
+                    i < m && (ch.discrepancy_lower[i] > 0.0 || ch.discrepancy_upper[i] < 0.0);
+                match (excludes, start) {
+                    (true, None) => start = Some(i),
+                    (false, Some(s)) => {
+                        let peak = (s..i)
+                            .map(|j| ch.discrepancy_mean[j].abs())
+                            .fold(0.0, f64::max);
+                        out.push(Mismatch {
+                            channel: key(problem, r, &ch.name),
+                            t_start: p.times[s],
+                            t_end: p.times[i - 1],
+                            max_over_sigma: peak / ch.sigma,
+                        });
+                        let _ = s;
+                        start = None;
+                    }
+                    _ => {}
+                }
+            }
+        }
+        predictives.push(p);
+    }
+    Ok((out, predictives))
+}
+
+/// Whether a mismatch covers enough of its record to say the model still lacks something.
+pub fn substantial(mismatch: &Mismatch, problem: &Problem) -> bool {
+    let duration = problem
+        .recordings
+        .iter()
+        .map(|r| r.last_time() - r.time.first().copied().unwrap_or(0.0))
+        .fold(0.0, f64::max);
+    mismatch.t_end - mismatch.t_start >= MISMATCH_MIN_SHARE * duration
+}
