@@ -43,6 +43,16 @@ enum Command {
         /// Length of the record [s].
         #[arg(long, default_value_t = 0.5)]
         t_end: f64,
+        /// A concealed-physics case instead: the hidden effect(s) (a term name, two comma
+        /// separated, or `none`); writes recording.csv, motor.toml and answer.json.
+        #[arg(long, value_delimiter = ',', conflicts_with_all = ["truth", "nominal"])]
+        effect: Option<Vec<String>>,
+        /// With --effect: the peak effect over the noise σ (default: drawn in 0.6..1.5).
+        #[arg(long, requires = "effect")]
+        magnitude: Option<f64>,
+        /// With --effect: keep the effect below 1.5σ and redraw until it is identifiable.
+        #[arg(long, requires = "effect")]
+        conceal: bool,
     },
     /// Calibrate a model file on a recording with BM1 or BM2(K): MAP, then MCMC.
     Fit(FitArgs),
@@ -384,7 +394,30 @@ fn run(cli: Cli) -> Result<(), AppError> {
             noise_sd,
             samples,
             t_end,
+            effect,
+            magnitude,
+            conceal,
         }) => {
+            if let Some(effects) = effect {
+                let answer = app::cases::make_case(&app::cases::CaseOptions {
+                    effects,
+                    magnitude,
+                    input,
+                    seed,
+                    conceal,
+                    out: out.clone(),
+                })?;
+                println!(
+                    "wrote {} (effect {}, peak {:.2}/{:.2} σ on I/ω, input {:?}{})",
+                    out.display(),
+                    answer.effect,
+                    answer.max_abs_effect_over_sigma["I"],
+                    answer.max_abs_effect_over_sigma["omega"],
+                    answer.input,
+                    if answer.input_fallback { ", after falling back" } else { "" }
+                );
+                return Ok(());
+            }
             let options = app::simulate::SimulateOptions {
                 truth,
                 nominal,

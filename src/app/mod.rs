@@ -2,6 +2,7 @@
 //! the library so that tests drive them exactly as a user does.
 
 pub mod bench;
+pub mod cases;
 pub mod diagnose;
 pub mod fit;
 pub mod predictive;
