@@ -48,7 +48,7 @@ enum Command {
         #[arg(long, value_delimiter = ',', conflicts_with_all = ["truth", "nominal"])]
         effect: Option<Vec<String>>,
         /// With --effect: the peak effect over the noise σ (default: drawn in 0.6..1.5).
-        #[arg(long, requires = "effect")]
+        #[arg(long, requires = "effect", allow_negative_numbers = true)]
         magnitude: Option<f64>,
         /// With --effect: keep the effect below 1.5σ and redraw until it is identifiable.
         #[arg(long, requires = "effect")]
@@ -414,7 +414,11 @@ fn run(cli: Cli) -> Result<(), AppError> {
                     answer.max_abs_effect_over_sigma["I"],
                     answer.max_abs_effect_over_sigma["omega"],
                     answer.input,
-                    if answer.input_fallback { ", after falling back" } else { "" }
+                    if answer.input_fallback {
+                        ", after falling back"
+                    } else {
+                        ""
+                    }
                 );
                 return Ok(());
             }

@@ -379,3 +379,62 @@ fn diagnose_refuses_bad_input_with_one_line_and_writes_nothing() {
     );
     assert!(!json.exists() && !out.exists());
 }
+
+#[test]
+fn simulate_effect_makes_a_concealed_fair_case() {
+    let dir = scratch("effect");
+    let o = motorcal(&[
+        "simulate",
+        "--effect",
+        "load_step",
+        "--conceal",
+        "--seed",
+        "5",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let answer: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("answer.json")).unwrap()).unwrap();
+    assert_eq!(answer["effect"], "load_step");
+    let peak = ["I", "omega"]
+        .iter()
+        .map(|c| answer["max_abs_effect_over_sigma"][c].as_f64().unwrap())
+        .fold(0.0, f64::max);
+    assert!(peak < 1.5 && peak > 0.1, "peak {peak}");
+    assert!(answer["oracle_margin"].as_f64().unwrap() >= 3.0);
+    assert!(answer["oracle_margin_over_none"].as_f64().unwrap() >= 5.0);
+    for f in ["recording.csv", "motor.toml"] {
+        assert!(dir.join(f).exists(), "{f}");
+    }
+}
+
+#[test]
+fn simulate_effect_refuses_what_it_cannot_make() {
+    let dir = scratch("effect-bad");
+    let out = dir.join("case");
+    let run = |extra: &[&str]| {
+        let mut args = vec!["simulate", "--out", out.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        motorcal(&args)
+    };
+    assert_clean_failure(
+        &run(&["--effect", "gremlins"]),
+        &["gremlins", "coulomb_friction"],
+    );
+    assert_clean_failure(
+        &run(&["--effect", "coulomb_friction", "--magnitude", "-1"]),
+        &["--magnitude -1"],
+    );
+    assert_clean_failure(
+        &run(&[
+            "--effect",
+            "coulomb_friction",
+            "--magnitude",
+            "2",
+            "--conceal",
+        ]),
+        &["--magnitude 2", "1.5"],
+    );
+    assert!(!out.exists());
+}

@@ -1,0 +1,450 @@
+//! Concealed-physics cases, built the way `../shared/data/concealed-dev/README.md` describes its
+//! own: the nominal motor of §2.1, a true R drawn from N(0.1, 0.005²), one hidden effect (or
+//! none, or two) scaled so that the noise-free truth minus the best nominal model (R refitted
+//! by weighted least squares) peaks at a chosen multiple of the noise σ, 501 samples over
+//! 0.5 s with σ_I = 2 A and σ_ω = 10 rad/s. `--conceal` keeps that peak below 1.5σ and redraws a
+//! case until the oracle ([`oracle`]) finds the effect identifiable on the noise-free truth; an
+//! effect that is not identifiable on the asked input after [`REDRAWS`] draws moves to a richer
+//! one (constant → step → reversal), recorded in `answer.json`.
+
+pub mod oracle;
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, Normal};
+use serde::Serialize;
+
+use crate::app::AppError;
+use crate::app::diagnose::problem_with;
+use crate::app::problem::Problem;
+use crate::app::simulate::InputProfile;
+use crate::io::{ModelFile, Recording, write_model_file, write_recording};
+use crate::motor::{MotorParam, Term, VoltageInput};
+use crate::ode::SolverSettings;
+use crate::parameter::Support;
+use crate::synthetic::sample_times;
+
+use oracle::{NONE_MARGIN, RUNNER_UP_MARGIN, least_squares};
+
+pub const NOISE_SD: [f64; 2] = [2.0, 10.0];
+pub const SAMPLES: usize = 501;
+pub const DURATION: f64 = 0.5;
+/// The largest peak effect a concealed case may have, in noise σ.
+pub const CONCEALED_MAX: f64 = 1.5;
+/// Draws per input before a richer input is tried.
+pub const REDRAWS: usize = 5;
+
+#[derive(Clone, Debug)]
+pub struct CaseOptions {
+    /// Effects to hide (`["none"]` for a null case).
+    pub effects: Vec<String>,
+    /// Target peak |effect| / σ; drawn from U(0.6, 1.5) when `None`.
+    pub magnitude: Option<f64>,
+    pub input: InputProfile,
+    pub seed: u64,
+    pub conceal: bool,
+    pub out: PathBuf,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Answer {
+    pub effect: String,
+    pub effects: Vec<String>,
+    pub params: BTreeMap<String, f64>,
+    pub input: InputProfile,
+    pub input_fallback: bool,
+    pub noise: BTreeMap<String, f64>,
+    pub seed: u64,
+    pub target_magnitude: f64,
+    pub max_abs_effect_over_sigma: BTreeMap<String, f64>,
+    pub r_of_refitted_nominal: f64,
+    /// The oracle's expected score lead of the truth over the best alternative model and over
+    /// none (nats; absent for a null case).
+    pub oracle_margin: Option<f64>,
+    pub oracle_runner_up: Option<String>,
+    pub oracle_margin_over_none: Option<f64>,
+    pub attempts: usize,
+}
+
+fn nominal_problem(input: &VoltageInput, times: &[f64]) -> Problem {
+    let voltage = match input {
+        VoltageInput::Held { values, .. } => Some(values.clone()),
+        VoltageInput::Constant => None,
+    };
+    Problem {
+        label: "case".into(),
+        recordings: vec![Recording {
+            source: "case".into(),
+            time: times.to_vec(),
+            channels: vec![
+                ("I".into(), vec![0.0; times.len()]),
+                ("omega".into(), vec![0.0; times.len()]),
+            ],
+            voltage,
+        }],
+        model: ModelFile::default(),
+        reference: None,
+    }
+}
+
+/// The truth's noise-free channels: the nominal model with the true R and the effects at
+/// `values` (each effect's parameters in its declaration order).
+fn truth_output(
+    base: &Problem,
+    r_true: f64,
+    effects: &[(String, Vec<f64>)],
+) -> Result<Vec<f64>, AppError> {
+    let names: Vec<String> = effects.iter().map(|(n, _)| n.clone()).collect();
+    let mut problem = problem_with(base, &names)?;
+    problem.model.motor.set(MotorParam::Resistance, r_true);
+    for (name, values) in effects {
+        if let Some(t) = problem
+            .model
+            .terms
+            .iter_mut()
+            .find(|t| t.term.name() == name)
+        {
+            t.values = values.clone();
+        }
+    }
+    problem.model.calibrate = Some(Vec::new());
+    let forward = problem.forward(SolverSettings::for_data_generation())?;
+    let mut out = vec![0.0; forward.n_outputs()];
+    forward
+        .simulate(&[], &mut out)
+        .map_err(|e| AppError::Numerical(e.to_string()))?;
+    Ok(out)
+}
+
+/// Peak |truth − best nominal| / σ per channel, and the refitted R.
+fn peak_over_sigma(base: &Problem, truth: &[f64]) -> Result<([f64; 2], f64), AppError> {
+    let (_, theta) = least_squares(base, &[], truth, &NOISE_SD)?;
+    let mut problem = problem_with(base, &[])?;
+    problem.model.calibrate = Some(Vec::new());
+    problem.model.motor.set(MotorParam::Resistance, theta[0]);
+    let forward = problem.forward(SolverSettings::default())?;
+    let mut out = vec![0.0; forward.n_outputs()];
+    forward
+        .simulate(&[], &mut out)
+        .map_err(|e| AppError::Numerical(e.to_string()))?;
+    let m = SAMPLES;
+    let mut peak = [0.0f64; 2];
+    for c in 0..2 {
+        for i in 0..m {
+            peak[c] = peak[c].max((truth[c * m + i] - out[c * m + i]).abs() / NOISE_SD[c]);
+        }
+    }
+    Ok((peak, theta[0]))
+}
+
+/// The effect's parameters with its size parameter (the first) at `size`; the other ones (a
+/// switching time) as drawn.
+fn with_size(drawn: &[f64], size: f64) -> Vec<f64> {
+    let mut v = drawn.to_vec();
+    v[0] = size;
+    v
+}
+
+/// Scales one effect's size parameter (keeping its sign) so that its peak is `target` σ:
+/// doubling to bracket, then bisection in log size.
+fn scale_effect(
+    base: &Problem,
+    r_true: f64,
+    name: &str,
+    drawn: &[f64],
+    sign: f64,
+    target: f64,
+) -> Result<f64, AppError> {
+    let peak = |size: f64| -> Result<f64, AppError> {
+        let truth = truth_output(
+            base,
+            r_true,
+            &[(name.into(), with_size(drawn, sign * size))],
+        )?;
+        let (p, _) = peak_over_sigma(base, &truth)?;
+        Ok(p[0].max(p[1]))
+    };
+    let mut lo = 1e-9;
+    let mut hi = 1e-9;
+    for _ in 0..80 {
+        if peak(hi)? >= target {
+            break;
+        }
+        lo = hi;
+        hi *= 2.0;
+    }
+    for _ in 0..40 {
+        let mid = (lo * hi).sqrt();
+        if peak(mid)? < target {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    Ok(sign * (lo * hi).sqrt())
+}
+
+/// The oracle's expected-score margins of a truth with `effects`: (lead over the best
+/// alternative, its name, lead over none). The alternatives of one effect are every other
+/// one-effect model and none; of two effects, each of the two alone and every pair that swaps
+/// one of them for another term.
+fn oracle_margins(
+    base: &Problem,
+    truth: &[f64],
+    effects: &[String],
+) -> Result<(f64, String, f64), AppError> {
+    let n = (2 * SAMPLES) as f64;
+    let score = |added: &[String]| -> Result<f64, AppError> {
+        let problem = problem_with(base, added)?;
+        let d = problem.calibrated_names()?.len() as f64 - 1.0;
+        let (ss, _) = least_squares(base, added, truth, &NOISE_SD)?;
+        Ok(-0.5 * ss - 0.5 * d * n.ln())
+    };
+    let own = score(effects)?;
+    let none = score(&[])?;
+    let mut alternatives: Vec<Vec<String>> = Vec::new();
+    let others: Vec<String> = Term::NAMES
+        .iter()
+        .filter(|t| !effects.iter().any(|e| e == *t))
+        .map(|t| t.to_string())
+        .collect();
+    if effects.len() == 1 {
+        alternatives.extend(others.iter().map(|o| vec![o.clone()]));
+    } else {
+        for (i, kept) in effects.iter().enumerate() {
+            alternatives.push(vec![kept.clone()]);
+            for o in &others {
+                let mut pair = effects.to_vec();
+                pair[1 - i] = o.clone();
+                alternatives.push(pair);
+            }
+        }
+    }
+    let mut runner_up = ("none".to_string(), none);
+    for alt in alternatives {
+        let s = score(&alt)?;
+        if s > runner_up.1 {
+            runner_up = (alt.join("+"), s);
+        }
+    }
+    Ok((own - runner_up.1, runner_up.0, own - none))
+}
+
+pub fn make_case(options: &CaseOptions) -> Result<Answer, AppError> {
+    let effects: Vec<String> = options
+        .effects
+        .iter()
+        .filter(|e| e.as_str() != "none")
+        .cloned()
+        .collect();
+    for e in &effects {
+        if Term::named(e).is_none() {
+            return Err(AppError::Usage(format!(
+                "--effect: unknown effect '{e}' (known: none, {})",
+                Term::NAMES.join(", ")
+            )));
+        }
+    }
+    if effects.len() > 2 {
+        return Err(AppError::Usage("--effect: at most two effects".into()));
+    }
+    if let Some(m) = options.magnitude
+        && !(m > 0.0 && m.is_finite())
+    {
+        return Err(AppError::Usage(format!(
+            "--magnitude {m}: must be a positive multiple of the noise σ"
+        )));
+    }
+    if options.conceal
+        && let Some(m) = options.magnitude
+        && m >= CONCEALED_MAX
+    {
+        return Err(AppError::Usage(format!(
+            "--magnitude {m} with --conceal: a concealed effect stays below {CONCEALED_MAX} σ"
+        )));
+    }
+    let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
+    let times = sample_times(DURATION, SAMPLES);
+    let ladder = [
+        InputProfile::Constant,
+        InputProfile::Step,
+        InputProfile::Reversal,
+    ];
+    let first = ladder.iter().position(|i| *i == options.input).unwrap_or(0);
+    let mut attempts = 0;
+    for (rung, &input) in ladder.iter().enumerate().skip(first) {
+        let voltage = input.voltage(24.0, &times);
+        let base = nominal_problem(&voltage, &times);
+        let tries = if options.conceal && !effects.is_empty() {
+            REDRAWS
+        } else {
+            1
+        };
+        for _ in 0..tries {
+            attempts += 1;
+            let r_true = 0.1 + 0.005 * Normal::<f64>::new(0.0, 1.0).unwrap().sample(&mut rng);
+            let target = options
+                .magnitude
+                .unwrap_or_else(|| rng.random_range(0.6..CONCEALED_MAX));
+            let mut hidden: Vec<(String, Vec<f64>)> = Vec::new();
+            for name in &effects {
+                let term = Term::named(name).expect("checked");
+                let drawn: Vec<f64> = term
+                    .params()
+                    .iter()
+                    .map(|p| match p.key {
+                        "t_s" => rng.random_range(0.2..0.8) * DURATION,
+                        _ => p.default,
+                    })
+                    .collect();
+                let magnitudes = base.model_for(&base.recordings[0])?.magnitudes(DURATION);
+                let sign = match (term.params()[0].support)(&magnitudes) {
+                    Support::Real if rng.random_bool(0.5) => -1.0,
+                    _ => 1.0,
+                };
+                let size = scale_effect(&base, r_true, name, &drawn, sign, target)?;
+                hidden.push((name.clone(), with_size(&drawn, size)));
+            }
+            let truth = truth_output(&base, r_true, &hidden)?;
+            let (peak, r_refit) = peak_over_sigma(&base, &truth)?;
+            // Two effects are each concealed (each alone peaks at the target); together they may
+            // show more, or less where they cancel: the answer records the combined peak. Both
+            // hidden below 1.5σ *together* and each told apart from its look-alikes is rarely
+            // possible on 501 samples (the oracle refuses most such draws).
+            if options.conceal && effects.len() == 1 && peak[0].max(peak[1]) >= CONCEALED_MAX {
+                continue;
+            }
+            let (margin, runner_up, over_none) = if effects.is_empty() {
+                (None, None, None)
+            } else {
+                let (a, b, c) = oracle_margins(&base, &truth, &effects)?;
+                (Some(a), Some(b), Some(c))
+            };
+            let fair = match (margin, over_none) {
+                (Some(a), Some(c)) => a >= RUNNER_UP_MARGIN && c >= NONE_MARGIN,
+                _ => true,
+            };
+            if options.conceal && !fair {
+                continue;
+            }
+            return write_case(
+                options,
+                &base,
+                &voltage,
+                r_true,
+                &hidden,
+                &truth,
+                peak,
+                r_refit,
+                target,
+                input,
+                rung != first,
+                margin,
+                runner_up,
+                over_none,
+                attempts,
+            );
+        }
+    }
+    Err(AppError::Usage(format!(
+        "--effect {}: not identifiable on any input after {attempts} draws",
+        options.effects.join(",")
+    )))
+}
+
+#[allow(clippy::too_many_arguments)]
+fn write_case(
+    options: &CaseOptions,
+    base: &Problem,
+    voltage: &VoltageInput,
+    r_true: f64,
+    hidden: &[(String, Vec<f64>)],
+    truth: &[f64],
+    peak: [f64; 2],
+    r_refit: f64,
+    target: f64,
+    input: InputProfile,
+    input_fallback: bool,
+    margin: Option<f64>,
+    runner_up: Option<String>,
+    over_none: Option<f64>,
+    attempts: usize,
+) -> Result<Answer, AppError> {
+    let times = base.recordings[0].time.clone();
+    let mut rng = ChaCha8Rng::seed_from_u64(options.seed ^ 0x6e6f_6973_6500);
+    let measured: Vec<Vec<f64>> = (0..2)
+        .map(|c| {
+            let normal = Normal::new(0.0, NOISE_SD[c]).expect("σ > 0");
+            (0..SAMPLES)
+                .map(|i| truth[c * SAMPLES + i] + normal.sample(&mut rng))
+                .collect()
+        })
+        .collect();
+    let recording = Recording {
+        source: "motorcal simulate --effect".into(),
+        time: times,
+        channels: vec![
+            ("I".into(), measured[0].clone()),
+            ("omega".into(), measured[1].clone()),
+        ],
+        voltage: match voltage {
+            VoltageInput::Held { values, .. } => Some(values.clone()),
+            VoltageInput::Constant => None,
+        },
+    };
+    let mut params = BTreeMap::new();
+    params.insert("R".to_string(), r_true);
+    let qualify = hidden.len() > 1;
+    for (name, values) in hidden {
+        let term = Term::named(name).expect("checked");
+        for (p, v) in term.params().iter().zip(values) {
+            let key = if qualify {
+                format!("{name}.{}", p.key)
+            } else {
+                p.key.to_string()
+            };
+            params.insert(key, *v);
+        }
+    }
+    let label = if hidden.is_empty() {
+        "none".to_string()
+    } else {
+        hidden
+            .iter()
+            .map(|(n, _)| n.clone())
+            .collect::<Vec<_>>()
+            .join(",")
+    };
+    let answer = Answer {
+        effect: label,
+        effects: hidden.iter().map(|(n, _)| n.clone()).collect(),
+        params,
+        input,
+        input_fallback,
+        noise: BTreeMap::from([
+            ("sigma_I".into(), NOISE_SD[0]),
+            ("sigma_omega".into(), NOISE_SD[1]),
+        ]),
+        seed: options.seed,
+        target_magnitude: target,
+        max_abs_effect_over_sigma: BTreeMap::from([
+            ("I".into(), peak[0]),
+            ("omega".into(), peak[1]),
+        ]),
+        r_of_refitted_nominal: r_refit,
+        oracle_margin: margin,
+        oracle_runner_up: runner_up,
+        oracle_margin_over_none: over_none,
+        attempts,
+    };
+    std::fs::create_dir_all(&options.out)?;
+    write_recording(&options.out.join("recording.csv"), &recording)?;
+    write_model_file(&options.out.join("motor.toml"), &ModelFile::default())?;
+    let text =
+        serde_json::to_string_pretty(&answer).map_err(|e| AppError::Output(e.to_string()))?;
+    crate::io::write_atomically(&options.out.join("answer.json"), text.as_bytes())?;
+    Ok(answer)
+}
