@@ -54,6 +54,9 @@ pub struct Answer {
     pub effect: String,
     pub effects: Vec<String>,
     pub params: BTreeMap<String, f64>,
+    /// The development set's type: A for a constant 24 V (no U column), B for a held profile.
+    #[serde(rename = "type")]
+    pub kind: String,
     pub input: InputProfile,
     pub input_fallback: bool,
     pub noise: BTreeMap<String, f64>,
@@ -422,6 +425,7 @@ fn write_case(
         effect: label,
         effects: hidden.iter().map(|(n, _)| n.clone()).collect(),
         params,
+        kind: if input == InputProfile::Constant { "A" } else { "B" }.into(),
         input,
         input_fallback,
         noise: BTreeMap::from([
