@@ -425,7 +425,12 @@ fn write_case(
         effect: label,
         effects: hidden.iter().map(|(n, _)| n.clone()).collect(),
         params,
-        kind: if input == InputProfile::Constant { "A" } else { "B" }.into(),
+        kind: if input == InputProfile::Constant {
+            "A"
+        } else {
+            "B"
+        }
+        .into(),
         input,
         input_fallback,
         noise: BTreeMap::from([

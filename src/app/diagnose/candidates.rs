@@ -46,6 +46,9 @@ pub struct CandidateFit {
     /// Added one-sided parameters the data do not hold away from their bound: the Laplace
     /// approximation is doubtful there.
     pub at_bound: Vec<String>,
+    /// The importance-sampling check of the Laplace evidence, where it was run; the score then
+    /// includes its correction.
+    pub confirmation: Option<super::confirm::Confirmation>,
 }
 
 /// The problem with `added` switched on (at their defaults) and calibrated with their default
@@ -126,10 +129,17 @@ pub fn fit_candidate_from(
     let laplace_sd = map.laplace_sd();
     for (i, (c, &value)) in posterior.calibrated().iter().zip(&theta_values).enumerate() {
         theta.insert(c.name.clone(), value);
-        // A one-sided parameter whose log has a Laplace sd above 1 is not held away from its
-        // bound by the data: the Gaussian approximation (and ½·ln N per parameter) is doubtful.
-        let one_sided = !matches!(c.support, Support::Real);
-        if added_names.contains(&c.name) && one_sided && laplace_sd[i] > 1.0 {
+        // Doubtful when the estimate lies within two Laplace sds of a bound (sds carried from
+        // the unconstrained coordinate by the transform's slope): the posterior is then cut by
+        // the bound, not Gaussian, and so is the ½·ln N per parameter of the score.
+        let slope = c.transform.map(map.x[i]).dx;
+        let sd = laplace_sd[i] * slope.abs();
+        let gap = match c.support {
+            Support::Positive => value,
+            Support::Bounded { lower, upper } => (value - lower).min(upper - value),
+            Support::Real => f64::INFINITY,
+        };
+        if added_names.contains(&c.name) && gap < 2.0 * sd {
             at_bound.push(c.name.clone());
         }
     }
@@ -142,6 +152,7 @@ pub fn fit_candidate_from(
         x: map.x,
         theta,
         at_bound,
+        confirmation: None,
     })
 }
 

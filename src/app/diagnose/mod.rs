@@ -13,6 +13,7 @@
 //! 7.4) positive evidence; the multiplicity of twelve candidates is why it is not 1.
 
 mod candidates;
+mod confirm;
 mod fits;
 mod report;
 mod screen;
@@ -26,6 +27,7 @@ use rayon::prelude::*;
 pub use candidates::{
     CandidateFit, answer_params, fit_candidate, fit_candidate_from, problem_with,
 };
+pub use confirm::{Confirmation, importance_evidence};
 pub use fits::{FitSummary, Mismatch, Whiteness, ljung_box};
 pub use report::{Diagnosis, RankEntry, format_diagnosis};
 
@@ -104,7 +106,27 @@ pub fn rank(problem: &Problem, candidates: &[String]) -> Result<Vec<CandidateFit
         .collect::<Result<Vec<_>, _>>()?;
     // Stable: equal scores keep the candidates' canonical order.
     fits.sort_by(|a, b| b.score.total_cmp(&a.score));
+    confirm_leaders(problem, &mut fits)?;
     Ok(fits)
+}
+
+/// How many leading candidates the sampling check looks at.
+const LEADERS: usize = 3;
+
+/// Where a leading candidate's Laplace approximation is doubtful (a parameter not held away
+/// from its bound), its score is corrected by the importance-sampling estimate's difference
+/// from the Laplace evidence, and the ranking re-sorted.
+fn confirm_leaders(problem: &Problem, fits: &mut [CandidateFit]) -> Result<(), AppError> {
+    let doubtful: Vec<usize> = (0..fits.len().min(LEADERS))
+        .filter(|&i| !fits[i].added.is_empty() && !fits[i].at_bound.is_empty())
+        .collect();
+    for i in doubtful {
+        let c = confirm::importance_evidence(problem, &fits[i], 0x1a9_1ace)?;
+        fits[i].score += c.log_evidence - c.log_evidence_laplace;
+        fits[i].confirmation = Some(c);
+    }
+    fits.sort_by(|a, b| b.score.total_cmp(&a.score));
+    Ok(())
 }
 
 /// Greedy forward selection from the best single candidate: the next term joins while it

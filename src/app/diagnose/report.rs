@@ -32,6 +32,8 @@ pub struct RankEntry {
     pub params: BTreeMap<String, Option<f64>>,
     /// Parameters the data do not hold away from their bound.
     pub at_bound: Vec<String>,
+    /// The importance-sampling check of the Laplace evidence, for a doubtful leader.
+    pub confirmation: Option<super::confirm::Confirmation>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -63,6 +65,7 @@ fn entry(fit: &CandidateFit, none: &CandidateFit) -> RankEntry {
         log_evidence_laplace: fit.log_evidence_laplace - none.log_evidence_laplace,
         params: answer_params(fit),
         at_bound: fit.at_bound.clone(),
+        confirmation: fit.confirmation,
     }
 }
 
