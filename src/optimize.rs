@@ -33,6 +33,23 @@ pub struct MapEstimate {
 }
 
 impl MapEstimate {
+    /// L⁻ᵀ with H = LLᵀ (x̂ + L⁻ᵀz is a draw of N(x̂, H⁻¹) for z standard normal), and
+    /// log det H.
+    pub fn whitening(&self) -> Result<(DMatrix<f64>, f64), String> {
+        let chol = self
+            .hessian
+            .clone()
+            .cholesky()
+            .ok_or("the Hessian at the MAP is not positive definite")?;
+        let l_inv_t = chol
+            .l()
+            .transpose()
+            .try_inverse()
+            .ok_or("singular Hessian")?;
+        let log_det = 2.0 * chol.l().diagonal().iter().map(|v| v.ln()).sum::<f64>();
+        Ok((l_inv_t, log_det))
+    }
+
     /// Marginal standard deviations of the Laplace approximation N(x̂, H⁻¹).
     pub fn laplace_sd(&self) -> Vec<f64> {
         match self.hessian.clone().cholesky() {

@@ -45,7 +45,7 @@ impl Problem {
         let reference = paper_reference(&setup, &data, &model.motor)?;
         Ok(Self {
             label: format!("paper synthetic data (seed {seed})"),
-            recordings: vec![recording_from(&data, "paper synthetic data")],
+            recordings: vec![recording_from(&data, "paper synthetic data", None)],
             model,
             reference: Some(reference),
         })
@@ -197,7 +197,9 @@ impl Problem {
     }
 }
 
-fn recording_from(data: &SyntheticData, source: &str) -> Recording {
+/// A synthetic recording as the reader would return it; `voltage` is the held input's values
+/// (`None` for a constant U).
+pub fn recording_from(data: &SyntheticData, source: &str, voltage: Option<Vec<f64>>) -> Recording {
     Recording {
         source: source.into(),
         time: data.times.clone(),
@@ -207,7 +209,7 @@ fn recording_from(data: &SyntheticData, source: &str) -> Recording {
             .cloned()
             .zip(data.measured.iter().cloned())
             .collect(),
-        voltage: None,
+        voltage,
     }
 }
 

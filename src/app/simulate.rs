@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
 
-use crate::io::{ModelFile, Recording, read_model_file, write_model_file, write_recording};
+use crate::io::{ModelFile, read_model_file, write_model_file, write_recording};
 use crate::motor::{MotorParameters, VoltageInput};
 use crate::synthetic::{DEFAULT_SEED, generate, sample_times};
 
@@ -144,17 +144,7 @@ pub fn simulate(options: &SimulateOptions) -> Result<SimulateReport, AppError> {
         VoltageInput::Held { values, .. } => Some(values),
         VoltageInput::Constant => None,
     };
-    let recording = Recording {
-        source: "motorcal simulate".into(),
-        time: times,
-        channels: data
-            .channel_names
-            .iter()
-            .cloned()
-            .zip(data.measured.iter().cloned())
-            .collect(),
-        voltage,
-    };
+    let recording = super::problem::recording_from(&data, "motorcal simulate", voltage);
     let report = SimulateReport {
         recording: options.out.join("recording.csv"),
         nominal: options.out.join("motor.toml"),

@@ -184,14 +184,7 @@ pub fn initial_points<P: LogDensity>(
     seed: u64,
 ) -> Result<Vec<Vec<f64>>, AppError> {
     let d = map.x.len();
-    let chol = map.hessian.clone().cholesky().ok_or_else(|| {
-        AppError::Numerical("the Hessian at the MAP is not positive definite".into())
-    })?;
-    let l_inv_t = chol
-        .l()
-        .transpose()
-        .try_inverse()
-        .ok_or_else(|| AppError::Numerical("singular Hessian".into()))?;
+    let (l_inv_t, _) = map.whitening().map_err(AppError::Numerical)?;
     let mut inits = Vec::with_capacity(chains);
     for chain in 0..chains {
         let mut rng = chain_rng(seed ^ 0x1a17_0000, chain);

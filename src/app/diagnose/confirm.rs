@@ -44,16 +44,8 @@ pub fn importance_evidence(
     let mut posterior = problem.posterior(&ModelSettings::bm1())?;
     let map = find_map(&mut posterior, &fit.x, &MapSettings::default())?;
     let d = map.x.len();
-    let chol = map.hessian.clone().cholesky().ok_or_else(|| {
-        AppError::Numerical("the Hessian at the MAP is not positive definite".into())
-    })?;
     // x = x̂ + L⁻ᵀ z √(ν/χ²): Student-t with scale matrix H⁻¹.
-    let l_inv_t = chol
-        .l()
-        .transpose()
-        .try_inverse()
-        .ok_or_else(|| AppError::Numerical("singular Hessian".into()))?;
-    let log_det_h: f64 = 2.0 * chol.l().diagonal().iter().map(|v| v.ln()).sum::<f64>();
+    let (l_inv_t, log_det_h) = map.whitening().map_err(AppError::Numerical)?;
     let log_t_norm = ln_gamma((NU + d as f64) / 2.0)
         - ln_gamma(NU / 2.0)
         - 0.5 * d as f64 * (NU * std::f64::consts::PI).ln()

@@ -7,9 +7,8 @@
 //! it. The input separates them when the selected one then leads by more than the threshold.
 
 use crate::app::AppError;
-use crate::app::problem::Problem;
+use crate::app::problem::{Problem, recording_from};
 use crate::app::simulate::InputProfile;
-use crate::io::Recording;
 use crate::motor::MotorParam;
 use crate::synthetic::generate;
 
@@ -39,17 +38,7 @@ pub fn separating_input(
             crate::motor::VoltageInput::Held { values, .. } => Some(values.clone()),
             crate::motor::VoltageInput::Constant => None,
         };
-        let synthetic = Recording {
-            source: format!("simulated {input:?} input"),
-            time: data.times.clone(),
-            channels: data
-                .channel_names
-                .iter()
-                .cloned()
-                .zip(data.measured.iter().cloned())
-                .collect(),
-            voltage: values,
-        };
+        let synthetic = recording_from(&data, &format!("simulated {input:?} input"), values);
         let experiment = Problem {
             label: synthetic.source.clone(),
             recordings: vec![synthetic],
