@@ -58,6 +58,10 @@ enum Command {
     Fit(FitArgs),
     /// Effective samples per second of every sampler across K, side by side.
     Bench(BenchArgs),
+    /// BM2 for each K on the paper's data: the error measures of §4.2 and Figures 8–11.
+    Sweep(SweepArgs),
+    /// Choose K by §3.2.3's rule: the smallest K whose σ posteriors stay put for K + 1..3.
+    SelectK(SweepArgs),
     /// Find the physics the model left out: locate the mismatch, rank candidate terms by
     /// evidence, add the best, refit, and show the fit improve.
     Diagnose(DiagnoseArgs),
@@ -216,6 +220,107 @@ fn fit(args: FitArgs) -> Result<(), AppError> {
     Ok(())
 }
 
+/// Discrepancy degrees as a range (`0..=20`, `3..10`) or a comma list (`0,3,9`).
+fn parse_ks(text: &str) -> Result<Vec<usize>, String> {
+    let bad = |e: &dyn std::fmt::Display| format!("'{text}': {e}");
+    if let Some((a, b)) = text.split_once("..") {
+        let (inclusive, b) = match b.strip_prefix('=') {
+            Some(b) => (true, b),
+            None => (false, b),
+        };
+        let a: usize = a.trim().parse().map_err(|e| bad(&e))?;
+        let b: usize = b.trim().parse().map_err(|e| bad(&e))?;
+        let end = if inclusive { b + 1 } else { b };
+        if end <= a {
+            return Err(format!("'{text}': an empty range"));
+        }
+        return Ok((a..end).collect());
+    }
+    text.split(',')
+        .map(|v| v.trim().parse::<usize>().map_err(|e| bad(&e)))
+        .collect()
+}
+
+#[derive(clap::Args)]
+struct SweepArgs {
+    /// Degrees: a range (0..=20) or a comma list (default 0..=20).
+    #[arg(long, default_value = "0..=20")]
+    k: String,
+    /// Seed of the synthetic noise (the paper's data: 20180823), apart from the chains' --seed.
+    #[arg(long, default_value_t = motorcal::synthetic::DEFAULT_SEED)]
+    data_seed: u64,
+    /// Decay power p of the coefficient prior variance V0/(j+1)^p (0: the paper's prior).
+    #[arg(long, default_value_t = 0.0)]
+    prior_decay: f64,
+    #[arg(long, value_enum, default_value_t = CoefficientFamily::Laplace)]
+    prior_family: CoefficientFamily,
+    #[arg(long, value_enum, default_value_t = app::run::SamplerKind::NutsDense)]
+    sampler: app::run::SamplerKind,
+    #[command(flatten)]
+    chains: ChainArgs,
+    #[arg(long, default_value_t = 1000)]
+    warmup: usize,
+    #[arg(long, default_value_t = 1000)]
+    draws: usize,
+    #[arg(long, default_value = "out/sweep")]
+    out: PathBuf,
+    /// Write the records (or, for select-k, the choice) as JSON here.
+    #[arg(long)]
+    json: Option<PathBuf>,
+}
+
+fn sweep(args: SweepArgs, select: bool) -> Result<(), AppError> {
+    let ks = parse_ks(&args.k).map_err(|e| AppError::Usage(format!("--k {e}")))?;
+    let options = app::sweep::SweepOptions {
+        ks,
+        coefficient_prior: CoefficientPrior {
+            family: args.prior_family,
+            decay_power: args.prior_decay,
+            ..CoefficientPrior::default()
+        },
+        data_seed: args.data_seed,
+        run: app::run::RunSettings {
+            sampler: args.sampler,
+            chains: args.chains.chains_or(4),
+            chain: motorcal::sampler::ChainSettings {
+                warmup: args.warmup,
+                draws: args.draws,
+                keep: None,
+            },
+            seed: args.chains.seed,
+            quiet: args.chains.quiet,
+            ..app::run::RunSettings::default()
+        },
+        out: args.out,
+        json: if select { None } else { args.json.clone() },
+    };
+    let records = app::sweep::sweep(&options)?;
+    print!("{}", app::sweep::format_table(&records));
+    for path in app::sweep::write_outputs(&records, &options)? {
+        println!("wrote {}", path.display());
+    }
+    if select {
+        let choice = app::sweep::select::sigma_stabilisation(&records);
+        for d in &choice.distances {
+            println!("K = {:>2}: distance {:.3}", d.k, d.distance);
+        }
+        match choice.k {
+            Some(k) => println!(
+                "chosen K = {k} (σ posteriors within {} sd for K + 1..3)",
+                choice.tolerance
+            ),
+            None => println!("no K of the sweep stabilises within {}", choice.tolerance),
+        }
+        if let Some(path) = &args.json {
+            let text = serde_json::to_string_pretty(&choice)
+                .map_err(|e| AppError::Output(e.to_string()))?;
+            motorcal::io::write_atomically(path, text.as_bytes())?;
+            println!("wrote {}", path.display());
+        }
+    }
+    Ok(())
+}
+
 #[derive(clap::Args)]
 struct DiagnoseArgs {
     /// A recording; repeat for several (shared physics, noise per recording).
@@ -280,9 +385,9 @@ fn diagnose(args: DiagnoseArgs) -> Result<(), AppError> {
 
 #[derive(clap::Args)]
 struct BenchArgs {
-    /// Discrepancy degrees, comma separated.
-    #[arg(long, value_delimiter = ',', default_values_t = motorcal::app::bench::DEFAULT_KS)]
-    k: Vec<usize>,
+    /// Discrepancy degrees: a comma list or a range (0..=20).
+    #[arg(long, default_value = "0,3,6,9,12,15,20")]
+    k: String,
     /// Samplers, comma separated (default: all).
     #[arg(long, value_enum, value_delimiter = ',')]
     samplers: Vec<app::run::SamplerKind>,
@@ -315,7 +420,7 @@ struct BenchArgs {
 fn bench(args: BenchArgs) -> Result<(), AppError> {
     let defaults = app::bench::BenchOptions::default();
     let options = app::bench::BenchOptions {
-        ks: args.k,
+        ks: parse_ks(&args.k).map_err(|e| AppError::Usage(format!("--k {e}")))?,
         samplers: if args.samplers.is_empty() {
             defaults.samplers
         } else {
@@ -385,6 +490,8 @@ fn run(cli: Cli) -> Result<(), AppError> {
         Some(Command::Fit(args)) => fit(args),
         Some(Command::Bench(args)) => bench(args),
         Some(Command::Diagnose(args)) => diagnose(args),
+        Some(Command::Sweep(args)) => sweep(args, false),
+        Some(Command::SelectK(args)) => sweep(args, true),
         Some(Command::Simulate {
             truth,
             nominal,

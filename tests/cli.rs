@@ -438,3 +438,14 @@ fn simulate_effect_refuses_what_it_cannot_make() {
     );
     assert!(!out.exists());
 }
+
+#[test]
+fn sweep_refuses_impossible_degrees_with_one_line() {
+    let dir = scratch("sweep-bad");
+    let out = dir.join("out");
+    let run = |k: &str| motorcal(&["sweep", "--k", k, "--out", out.to_str().unwrap()]);
+    assert_clean_failure(&run("5..2"), &["5..2", "empty"]);
+    assert_clean_failure(&run("0,x"), &["0,x"]);
+    assert_clean_failure(&run("3,41"), &["--k 41"]);
+    assert!(!out.exists());
+}

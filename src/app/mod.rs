@@ -11,6 +11,7 @@ pub mod problem;
 pub use crate::pipeline as run;
 pub mod simulate;
 pub mod summarize;
+pub mod sweep;
 pub mod table1;
 
 use std::fmt;

@@ -45,6 +45,15 @@ impl Default for CoefficientPrior {
 }
 
 impl CoefficientPrior {
+    /// "laplace, p = 0" (the paper's), "gaussian, p = 2", …
+    pub fn label(&self) -> String {
+        let family = match self.family {
+            CoefficientFamily::Laplace => "laplace",
+            CoefficientFamily::Gaussian => "gaussian",
+        };
+        format!("{family}, p = {}", self.decay_power)
+    }
+
     /// The prior of coefficient a_j.
     pub fn prior(&self, j: usize) -> super::Prior {
         let variance = 2.0 * self.scale * self.scale / ((j + 1) as f64).powf(self.decay_power);
