@@ -1,6 +1,6 @@
 //! The `motorcal` command line: parses options and calls the library (`motorcal::app`).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
@@ -267,10 +267,20 @@ struct SweepArgs {
     /// Write the records (or, for select-k, the choice) as JSON here.
     #[arg(long)]
     json: Option<PathBuf>,
+    /// select-k: `sigma-stabilisation` (§3.2.3) or `evidence` (the largest log marginal
+    /// likelihood, by importance sampling).
+    #[arg(long, default_value = "sigma-stabilisation")]
+    rule: String,
 }
 
 fn sweep(args: SweepArgs, select: bool) -> Result<(), AppError> {
     let ks = parse_ks(&args.k).map_err(|e| AppError::Usage(format!("--k {e}")))?;
+    if !["sigma-stabilisation", "evidence"].contains(&args.rule.as_str()) {
+        return Err(AppError::Usage(format!(
+            "--rule {}: known rules are sigma-stabilisation and evidence",
+            args.rule
+        )));
+    }
     let options = app::sweep::SweepOptions {
         ks,
         coefficient_prior: CoefficientPrior {
@@ -299,7 +309,25 @@ fn sweep(args: SweepArgs, select: bool) -> Result<(), AppError> {
     for path in app::sweep::write_outputs(&records, &options)? {
         println!("wrote {}", path.display());
     }
-    if select {
+    if select && args.rule == "evidence" {
+        let choice = app::sweep::select::evidence(&records);
+        for e in &choice.evidences {
+            println!(
+                "K = {:>2}: log evidence {:.2} ± {:.2} ({:.0} effective draws{}), Laplace {:.2}",
+                e.k,
+                e.log_evidence,
+                e.standard_error,
+                e.effective_draws,
+                if e.trusted { "" } else { ", not trusted" },
+                e.log_evidence_laplace
+            );
+        }
+        match choice.k {
+            Some(k) => println!("chosen K = {k} (largest evidence)"),
+            None => println!("no evidence estimate has enough effective draws"),
+        }
+        write_choice(args.json.as_deref(), &choice)?;
+    } else if select {
         let choice = app::sweep::select::sigma_stabilisation(&records);
         for d in &choice.distances {
             println!("K = {:>2}: distance {:.3}", d.k, d.distance);
@@ -311,12 +339,17 @@ fn sweep(args: SweepArgs, select: bool) -> Result<(), AppError> {
             ),
             None => println!("no K of the sweep stabilises within {}", choice.tolerance),
         }
-        if let Some(path) = &args.json {
-            let text = serde_json::to_string_pretty(&choice)
-                .map_err(|e| AppError::Output(e.to_string()))?;
-            motorcal::io::write_atomically(path, text.as_bytes())?;
-            println!("wrote {}", path.display());
-        }
+        write_choice(args.json.as_deref(), &choice)?;
+    }
+    Ok(())
+}
+
+fn write_choice<T: serde::Serialize>(path: Option<&Path>, choice: &T) -> Result<(), AppError> {
+    if let Some(path) = path {
+        let text =
+            serde_json::to_string_pretty(choice).map_err(|e| AppError::Output(e.to_string()))?;
+        motorcal::io::write_atomically(path, text.as_bytes())?;
+        println!("wrote {}", path.display());
     }
     Ok(())
 }

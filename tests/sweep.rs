@@ -2,7 +2,7 @@
 //! measures, and `select-k`'s σ rule sees that K = 0 has not stabilised (the discrepancy is
 //! not yet captured, so the noise σ is overestimated, §4.2).
 
-use motorcal::app::sweep::select::{TOLERANCE, sigma_stabilisation, wasserstein_1};
+use motorcal::app::sweep::select::{TOLERANCE, evidence, sigma_stabilisation, wasserstein_1};
 use motorcal::app::sweep::{SweepOptions, sweep, write_outputs};
 use motorcal::bayes::CoefficientPrior;
 use motorcal::pipeline::{RunSettings, SamplerKind};
@@ -49,6 +49,19 @@ fn a_sweep_writes_the_papers_error_measures_and_k0_has_not_stabilised() {
     let d0 = choice.distances.iter().find(|d| d.k == 0).unwrap().distance;
     eprintln!("distances {:?}", choice.distances);
     assert!(d0 > TOLERANCE, "K = 0 looks stable: {d0}");
+    // The data carry a discrepancy: a δ of degree 4 is far more probable than a constant one,
+    // and at these small K the importance-sampling evidence stays near the Laplace value.
+    let ev = evidence(&records);
+    eprintln!("evidences {:?}", ev.evidences);
+    let at = |k: usize| ev.evidences.iter().find(|e| e.k == k).unwrap();
+    assert!(at(4).log_evidence > at(0).log_evidence + 100.0);
+    for e in &ev.evidences {
+        assert!(e.trusted, "{e:?}");
+        assert!(
+            (e.log_evidence - e.log_evidence_laplace).abs() < 1.0,
+            "{e:?}"
+        );
+    }
     let _ = std::fs::remove_dir_all(&opts.out);
 }
 

@@ -97,6 +97,54 @@ pub fn sigma_stabilisation(records: &[SweepRecord]) -> Selection {
     }
 }
 
+/// Effective importance draws below which an evidence estimate is not trusted.
+pub const MIN_EFFECTIVE_DRAWS: f64 = 100.0;
+
+#[derive(Clone, Debug, Serialize)]
+pub struct KEvidence {
+    pub k: usize,
+    pub log_evidence: f64,
+    pub standard_error: f64,
+    pub effective_draws: f64,
+    pub log_evidence_laplace: f64,
+    /// Whether the estimate has enough effective draws to be ranked.
+    pub trusted: bool,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct EvidenceSelection {
+    pub k: Option<usize>,
+    pub rule: String,
+    pub evidences: Vec<KEvidence>,
+}
+
+/// The K of largest log evidence (importance sampling), among estimates with at least
+/// [`MIN_EFFECTIVE_DRAWS`] effective draws.
+pub fn evidence(records: &[SweepRecord]) -> EvidenceSelection {
+    let mut evidences: Vec<KEvidence> = records
+        .iter()
+        .map(|r| KEvidence {
+            k: r.k,
+            log_evidence: r.evidence.log_evidence,
+            standard_error: r.evidence.standard_error,
+            effective_draws: r.evidence.effective_draws,
+            log_evidence_laplace: r.evidence.log_evidence_laplace,
+            trusted: r.evidence.effective_draws >= MIN_EFFECTIVE_DRAWS,
+        })
+        .collect();
+    evidences.sort_by_key(|e| e.k);
+    let k = evidences
+        .iter()
+        .filter(|e| e.trusted)
+        .max_by(|a, b| a.log_evidence.total_cmp(&b.log_evidence))
+        .map(|e| e.k);
+    EvidenceSelection {
+        k,
+        rule: "evidence".into(),
+        evidences,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::wasserstein_1;
