@@ -65,7 +65,8 @@ fn main() {
         let options = SweepOptions {
             ks: (0..=20).collect(),
             coefficient_prior: CoefficientPrior::default(),
-            data_seed,
+            data_seeds: vec![data_seed],
+            shard: None,
             run: run.clone(),
             out: out.clone(),
             json: None,
@@ -74,7 +75,7 @@ fn main() {
         let records: Vec<SweepRecord> = options
             .ks
             .iter()
-            .map(|&k| run_k(&problem, k, &options).expect("a K runs"))
+            .map(|&k| run_k(&problem, data_seed, k, &options).expect("a K runs"))
             .collect();
         let k_sigma = sigma_stabilisation(&records).k;
         let k_evidence = evidence(&records).k;

@@ -8,7 +8,7 @@
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{ChiSquared, Distribution, StandardNormal};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use statrs::function::gamma::ln_gamma;
 
 use crate::density::LogDensity;
@@ -18,7 +18,7 @@ use crate::optimize::MapEstimate;
 const NU: f64 = 5.0;
 
 /// An importance-sampling estimate of the log evidence, beside the Laplace value.
-#[derive(Clone, Copy, Debug, Serialize)]
+#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
 pub struct Evidence {
     pub log_evidence: f64,
     /// Monte Carlo standard error of `log_evidence` (delta method).

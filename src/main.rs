@@ -62,6 +62,15 @@ enum Command {
     Sweep(SweepArgs),
     /// Choose K by §3.2.3's rule: the smallest K whose σ posteriors stay put for K + 1..3.
     SelectK(SweepArgs),
+    /// Join the JSON of sweep shards into what one unsharded sweep writes.
+    Merge {
+        #[arg(required = true)]
+        parts: Vec<PathBuf>,
+        #[arg(long, default_value = "out/sweep")]
+        out: PathBuf,
+        #[arg(long)]
+        json: Option<PathBuf>,
+    },
     /// Find the physics the model left out: locate the mismatch, rank candidate terms by
     /// evidence, add the best, refit, and show the fit improve.
     Diagnose(DiagnoseArgs),
@@ -246,9 +255,14 @@ struct SweepArgs {
     /// Degrees: a range (0..=20) or a comma list (default 0..=20).
     #[arg(long, default_value = "0..=20")]
     k: String,
-    /// Seed of the synthetic noise (the paper's data: 20180823), apart from the chains' --seed.
-    #[arg(long, default_value_t = motorcal::synthetic::DEFAULT_SEED)]
-    data_seed: u64,
+    /// Seeds of the synthetic noise, apart from the chains' --seed: one, a list or a range
+    /// (default: the paper's data, 20180823). The grid is every (seed, K).
+    #[arg(long, default_value = "20180823")]
+    data_seed: String,
+    /// Run one slice of the grid: grid points whose index is i − 1 modulo n (`--shard 3/8`);
+    /// `motorcal merge` joins the slices' JSON into what one run writes.
+    #[arg(long)]
+    shard: Option<String>,
     /// Decay power p of the coefficient prior variance V0/(j+1)^p (0: the paper's prior).
     #[arg(long, default_value_t = 0.0)]
     prior_decay: f64,
@@ -288,7 +302,15 @@ fn sweep(args: SweepArgs, select: bool) -> Result<(), AppError> {
             decay_power: args.prior_decay,
             ..CoefficientPrior::default()
         },
-        data_seed: args.data_seed,
+        data_seeds: parse_ks(&args.data_seed)
+            .map_err(|e| AppError::Usage(format!("--data-seed {e}")))?
+            .into_iter()
+            .map(|s| s as u64)
+            .collect(),
+        shard: match &args.shard {
+            None => None,
+            Some(text) => Some(parse_shard(text)?),
+        },
         run: app::run::RunSettings {
             sampler: args.sampler,
             chains: args.chains.chains_or(4),
@@ -304,6 +326,11 @@ fn sweep(args: SweepArgs, select: bool) -> Result<(), AppError> {
         out: args.out,
         json: if select { None } else { args.json.clone() },
     };
+    if select && (options.shard.is_some() || options.data_seeds.len() > 1) {
+        return Err(AppError::Usage(
+            "select-k judges one whole sweep: no --shard, one --data-seed".into(),
+        ));
+    }
     let records = app::sweep::sweep(&options)?;
     print!("{}", app::sweep::format_table(&records));
     for path in app::sweep::write_outputs(&records, &options)? {
@@ -340,6 +367,49 @@ fn sweep(args: SweepArgs, select: bool) -> Result<(), AppError> {
             None => println!("no K of the sweep stabilises within {}", choice.tolerance),
         }
         write_choice(args.json.as_deref(), &choice)?;
+    }
+    Ok(())
+}
+
+fn parse_shard(text: &str) -> Result<(usize, usize), AppError> {
+    let bad = || {
+        AppError::Usage(format!(
+            "--shard {text}: write i/n with 1 ≤ i ≤ n, e.g. 3/8"
+        ))
+    };
+    let (i, n) = text.split_once('/').ok_or_else(bad)?;
+    let (i, n): (usize, usize) = (
+        i.trim().parse().map_err(|_| bad())?,
+        n.trim().parse().map_err(|_| bad())?,
+    );
+    if !(n >= 1 && (1..=n).contains(&i)) {
+        return Err(bad());
+    }
+    Ok((i, n))
+}
+
+fn merge(parts: Vec<PathBuf>, out: PathBuf, json: Option<PathBuf>) -> Result<(), AppError> {
+    let mut loaded = Vec::new();
+    for path in &parts {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| AppError::Usage(format!("{}: {e}", path.display())))?;
+        let records: Vec<app::sweep::SweepRecord> = serde_json::from_str(&text)
+            .map_err(|e| AppError::Usage(format!("{}: line {}: {e}", path.display(), e.line())))?;
+        loaded.push(records);
+    }
+    let records = app::sweep::merge(loaded)?;
+    let options = app::sweep::SweepOptions {
+        ks: Vec::new(),
+        coefficient_prior: CoefficientPrior::default(),
+        data_seeds: Vec::new(),
+        shard: None,
+        run: app::run::RunSettings::default(),
+        out,
+        json,
+    };
+    print!("{}", app::sweep::format_table(&records));
+    for path in app::sweep::write_outputs(&records, &options)? {
+        println!("wrote {}", path.display());
     }
     Ok(())
 }
@@ -525,6 +595,7 @@ fn run(cli: Cli) -> Result<(), AppError> {
         Some(Command::Diagnose(args)) => diagnose(args),
         Some(Command::Sweep(args)) => sweep(args, false),
         Some(Command::SelectK(args)) => sweep(args, true),
+        Some(Command::Merge { parts, out, json }) => merge(parts, out, json),
         Some(Command::Simulate {
             truth,
             nominal,

@@ -3,7 +3,7 @@
 //! not yet captured, so the noise σ is overestimated, §4.2).
 
 use motorcal::app::sweep::select::{TOLERANCE, evidence, sigma_stabilisation, wasserstein_1};
-use motorcal::app::sweep::{SweepOptions, sweep, write_outputs};
+use motorcal::app::sweep::{SweepOptions, merge, sweep, write_outputs};
 use motorcal::bayes::CoefficientPrior;
 use motorcal::pipeline::{RunSettings, SamplerKind};
 use motorcal::sampler::ChainSettings;
@@ -12,7 +12,8 @@ fn options(ks: Vec<usize>, out: &str) -> SweepOptions {
     SweepOptions {
         ks,
         coefficient_prior: CoefficientPrior::default(),
-        data_seed: motorcal::synthetic::DEFAULT_SEED,
+        data_seeds: vec![motorcal::synthetic::DEFAULT_SEED],
+        shard: None,
         run: RunSettings {
             sampler: SamplerKind::NutsDense,
             chains: 2,
@@ -73,4 +74,36 @@ fn wasserstein_distance_is_symmetric_and_sees_a_spread() {
     assert!((ab - ba).abs() < 1e-12);
     // |2u − 0.5 − u| integrated over [0, 1] = ∫|u − 0.5| = 0.25
     assert!((ab - 0.25).abs() < 1e-3, "{ab}");
+}
+
+/// The JSON a run writes, with the wall times (the one field a rerun cannot repeat) zeroed.
+fn without_wall_times(records: &[motorcal::app::sweep::SweepRecord]) -> String {
+    let mut v = serde_json::to_value(records).unwrap();
+    for r in v.as_array_mut().unwrap() {
+        r["wall_s"] = serde_json::json!(0.0);
+    }
+    serde_json::to_string_pretty(&v).unwrap()
+}
+
+#[test]
+fn three_shards_merged_are_the_unsharded_sweep() {
+    let mut opts = options(vec![0, 1, 2], "shards");
+    opts.data_seeds = vec![5, 6];
+    let whole = sweep(&opts).unwrap();
+    let mut parts = Vec::new();
+    for i in 1..=3 {
+        let mut o = opts.clone();
+        o.shard = Some((i, 3));
+        let part = sweep(&o).unwrap();
+        assert_eq!(
+            part.len(),
+            2,
+            "shard {i}/3 holds two of the six grid points"
+        );
+        // Through JSON, as the files travel between machines.
+        let text = serde_json::to_string(&part).unwrap();
+        parts.push(serde_json::from_str(&text).unwrap());
+    }
+    let merged = merge(parts).unwrap();
+    assert_eq!(without_wall_times(&merged), without_wall_times(&whole));
 }

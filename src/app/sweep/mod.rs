@@ -7,7 +7,7 @@ pub mod select;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::app::AppError;
 use crate::app::problem::{Problem, Reference};
@@ -29,15 +29,17 @@ const EVIDENCE_SEED: u64 = 0xe71d_e9ce;
 pub struct SweepOptions {
     pub ks: Vec<usize>,
     pub coefficient_prior: CoefficientPrior,
-    /// Seed of the synthetic noise (the paper's data: 20180823).
-    pub data_seed: u64,
+    /// Seeds of the synthetic noise (the paper's data: 20180823); the grid is K × seed.
+    pub data_seeds: Vec<u64>,
+    /// `(i, n)`: run only the grid points whose index is i − 1 modulo n (1 ≤ i ≤ n).
+    pub shard: Option<(usize, usize)>,
     pub run: RunSettings,
     pub out: PathBuf,
     pub json: Option<PathBuf>,
 }
 
 /// Definition 4.2 of one scalar against its reference, with the posterior's summary.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct ScalarStats {
     pub mean: f64,
     pub sd: f64,
@@ -52,7 +54,7 @@ pub struct ScalarStats {
 }
 
 /// Definition 4.3 of δ on one channel against d0 (L² norms over the sample times).
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct DiscrepancyStats {
     pub n_bias: f64,
     pub n_v: f64,
@@ -61,7 +63,8 @@ pub struct DiscrepancyStats {
     pub n_mse_bound: f64,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct SweepRecord {
     pub k: usize,
     pub prior: String,
@@ -82,7 +85,7 @@ pub struct SweepRecord {
     /// the Laplace value itself (which misses the coefficient prior's kink at 0).
     pub evidence: crate::evidence::Evidence,
     /// Pooled draws of σ_I and σ_ω, for `select-k` (not written).
-    #[serde(skip)]
+    #[serde(skip, default)]
     pub sigma_draws: [Vec<f64>; 2],
 }
 
@@ -113,8 +116,13 @@ fn pooled(run: &RunOutput, name: &str) -> Vec<f64> {
         .collect()
 }
 
-/// One K: the run and its statistics.
-pub fn run_k(problem: &Problem, k: usize, options: &SweepOptions) -> Result<SweepRecord, AppError> {
+/// One K on `problem`, the paper's set-up made with `data_seed`: the run and its statistics.
+pub fn run_k(
+    problem: &Problem,
+    data_seed: u64,
+    k: usize,
+    options: &SweepOptions,
+) -> Result<SweepRecord, AppError> {
     let reference: &Reference = problem
         .reference
         .as_ref()
@@ -178,7 +186,7 @@ pub fn run_k(problem: &Problem, k: usize, options: &SweepOptions) -> Result<Swee
     Ok(SweepRecord {
         k,
         prior: options.coefficient_prior.label(),
-        data_seed: options.data_seed,
+        data_seed,
         chain_seed: options.run.seed,
         sampler: run.sampler.clone(),
         r,
@@ -200,10 +208,42 @@ pub fn run_k(problem: &Problem, k: usize, options: &SweepOptions) -> Result<Swee
     })
 }
 
-/// Every K in turn, on the paper's data for `data_seed`.
+/// The grid in its fixed order: data seed, then K.
+pub fn grid(options: &SweepOptions) -> Vec<(u64, usize)> {
+    options
+        .data_seeds
+        .iter()
+        .flat_map(|&s| options.ks.iter().map(move |&k| (s, k)))
+        .collect()
+}
+
+/// The grid points of a shard.
+pub fn shard_of(options: &SweepOptions) -> Vec<(u64, usize)> {
+    let all = grid(options);
+    match options.shard {
+        None => all,
+        Some((i, n)) => all
+            .into_iter()
+            .enumerate()
+            .filter(|(j, _)| j % n == i - 1)
+            .map(|(_, p)| p)
+            .collect(),
+    }
+}
+
+/// Every grid point of this shard (all of them without `--shard`), on the paper's set-up with
+/// each data seed.
 pub fn sweep(options: &SweepOptions) -> Result<Vec<SweepRecord>, AppError> {
     if options.ks.is_empty() {
         return Err(AppError::Usage("--k: no degree given".into()));
+    }
+    if options.data_seeds.is_empty() {
+        return Err(AppError::Usage("--data-seed: no seed given".into()));
+    }
+    if let Some((i, n)) = options.shard
+        && !(n >= 1 && (1..=n).contains(&i))
+    {
+        return Err(AppError::Usage(format!("--shard {i}/{n}: need 1 ≤ i ≤ n")));
     }
     options.run.validate()?;
     for &k in &options.ks {
@@ -213,12 +253,31 @@ pub fn sweep(options: &SweepOptions) -> Result<Vec<SweepRecord>, AppError> {
             .validate()
             .map_err(|e| AppError::Usage(format!("--k {k}: {e}")))?;
     }
-    let problem = Problem::paper(options.data_seed)?;
-    options
-        .ks
-        .iter()
-        .map(|&k| run_k(&problem, k, options))
-        .collect()
+    let mut records = Vec::new();
+    let mut problem: Option<(u64, Problem)> = None;
+    for (seed, k) in shard_of(options) {
+        if problem.as_ref().is_none_or(|(s, _)| *s != seed) {
+            problem = Some((seed, Problem::paper(seed)?));
+        }
+        let (_, p) = problem.as_ref().expect("made above");
+        records.push(run_k(p, seed, k, options)?);
+    }
+    Ok(records)
+}
+
+/// Shards' records back into one run's: every grid point once, in the grid's order.
+pub fn merge(mut parts: Vec<Vec<SweepRecord>>) -> Result<Vec<SweepRecord>, AppError> {
+    let mut all: Vec<SweepRecord> = parts.drain(..).flatten().collect();
+    all.sort_by_key(|r| (r.data_seed, r.k));
+    for pair in all.windows(2) {
+        if (pair[0].data_seed, pair[0].k) == (pair[1].data_seed, pair[1].k) {
+            return Err(AppError::Usage(format!(
+                "merge: K = {} with data seed {} appears in two shards",
+                pair[0].k, pair[0].data_seed
+            )));
+        }
+    }
+    Ok(all)
 }
 
 /// `sweep.csv`, `sweep.json` (or `--json`) and the figures.
@@ -289,7 +348,11 @@ pub fn write_outputs(
         serde_json::to_string_pretty(records).map_err(|e| AppError::Output(e.to_string()))?;
     crate::io::write_atomically(&path, text.as_bytes())?;
     written.push(path);
-    written.extend(figures(records, options)?);
+    // Figures against K are of one data set; a grid over several seeds is for the tables.
+    let one_seed = records.windows(2).all(|w| w[0].data_seed == w[1].data_seed);
+    if one_seed && !records.is_empty() {
+        written.extend(figures(records, options)?);
+    }
     Ok(written)
 }
 
