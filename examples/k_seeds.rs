@@ -70,6 +70,7 @@ fn main() {
             run: run.clone(),
             out: out.clone(),
             json: None,
+            figures_at: Vec::new(),
         };
         let problem = Problem::paper(data_seed).expect("the paper's data");
         let records: Vec<SweepRecord> = options

@@ -281,6 +281,9 @@ struct SweepArgs {
     /// Write the records (or, for select-k, the choice) as JSON here.
     #[arg(long)]
     json: Option<PathBuf>,
+    /// Degrees at which to draw δ's band against d0 and the coefficients' marginals (a list).
+    #[arg(long)]
+    figures_at: Option<String>,
     /// select-k: `sigma-stabilisation` (§3.2.3) or `evidence` (the largest log marginal
     /// likelihood, by importance sampling).
     #[arg(long, default_value = "sigma-stabilisation")]
@@ -325,6 +328,12 @@ fn sweep(args: SweepArgs, select: bool) -> Result<(), AppError> {
         },
         out: args.out,
         json: if select { None } else { args.json.clone() },
+        figures_at: match &args.figures_at {
+            None => Vec::new(),
+            Some(text) => {
+                parse_ks(text).map_err(|e| AppError::Usage(format!("--figures-at {e}")))?
+            }
+        },
     };
     if select && (options.shard.is_some() || options.data_seeds.len() > 1) {
         return Err(AppError::Usage(
@@ -406,6 +415,7 @@ fn merge(parts: Vec<PathBuf>, out: PathBuf, json: Option<PathBuf>) -> Result<(),
         run: app::run::RunSettings::default(),
         out,
         json,
+        figures_at: Vec::new(),
     };
     print!("{}", app::sweep::format_table(&records));
     for path in app::sweep::write_outputs(&records, &options)? {

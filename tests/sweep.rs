@@ -27,12 +27,14 @@ fn options(ks: Vec<usize>, out: &str) -> SweepOptions {
         },
         out: std::env::temp_dir().join(format!("motorcal-sweep-{}-{out}", std::process::id())),
         json: None,
+        figures_at: Vec::new(),
     }
 }
 
 #[test]
 fn a_sweep_writes_the_papers_error_measures_and_k0_has_not_stabilised() {
-    let opts = options((0..=4).collect(), "small");
+    let mut opts = options((0..=4).collect(), "small");
+    opts.figures_at = vec![4];
     let records = sweep(&opts).unwrap();
     assert_eq!(
         records.iter().map(|r| r.k).collect::<Vec<_>>(),
@@ -46,6 +48,9 @@ fn a_sweep_writes_the_papers_error_measures_and_k0_has_not_stabilised() {
     }
     let written = write_outputs(&records, &opts).unwrap();
     assert!(written.iter().all(|p| p.exists()), "{written:?}");
+    for figure in ["fig13-delta-k4.png", "fig14-coefficients-k4.png"] {
+        assert!(opts.out.join(figure).exists(), "{figure}");
+    }
     let choice = sigma_stabilisation(&records);
     let d0 = choice.distances.iter().find(|d| d.k == 0).unwrap().distance;
     eprintln!("distances {:?}", choice.distances);

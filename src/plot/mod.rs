@@ -10,6 +10,7 @@
 //! Robustness: non-finite values are skipped, a zero-width data range is padded, and on a
 //! logarithmic axis non-positive values are skipped.
 
+mod coefficients;
 mod discrepancy;
 mod ess;
 mod frame;
@@ -23,6 +24,7 @@ use std::fmt;
 
 use plotters::prelude::DrawingAreaErrorKind;
 
+pub use coefficients::{CoefficientMarginals, coefficient_marginals};
 pub use discrepancy::{DiscrepancyBand, discrepancy_band};
 pub use ess::{SamplerCurve, ess_per_second};
 pub use k_study::{KSeries, k_study};

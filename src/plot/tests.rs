@@ -439,3 +439,32 @@ fn axes_are_sane() {
     assert_eq!(fmt_sig(1e-5), "1e-5");
     assert_eq!(fmt_sig(0.30000000000000004), "0.3");
 }
+
+#[test]
+fn coefficient_marginals_write_png_and_refuse_mismatched_lengths() {
+    let path = out("coefficients");
+    let channel = |name: &str, scale: f64| CoefficientMarginals {
+        name: name.into(),
+        unit: "A".into(),
+        mean: (0..10).map(|j| scale / (j as f64 + 1.0)).collect(),
+        lower: (0..10)
+            .map(|j| scale / (j as f64 + 1.0) - 0.3 * scale)
+            .collect(),
+        upper: (0..10)
+            .map(|j| scale / (j as f64 + 1.0) + 0.3 * scale)
+            .collect(),
+        reference: Some((0..10).map(|j| scale * 0.9 / (j as f64 + 1.0)).collect()),
+    };
+    coefficient_marginals(
+        &path,
+        "coefficients",
+        &[channel("I", 1.0), channel("omega", 40.0)],
+    )
+    .unwrap();
+    assert_png(&path);
+    let bad = out("coefficients_bad");
+    let mut broken = channel("I", 1.0);
+    broken.upper.pop();
+    assert!(coefficient_marginals(&bad, "bad", &[broken]).is_err());
+    assert!(!bad.exists());
+}

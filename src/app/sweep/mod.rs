@@ -36,6 +36,9 @@ pub struct SweepOptions {
     pub run: RunSettings,
     pub out: PathBuf,
     pub json: Option<PathBuf>,
+    /// Degrees at which to draw δ's band against d0 (Figures 13/16) and the coefficients'
+    /// marginals against d0's least-squares coefficients (Figures 14/17).
+    pub figures_at: Vec<usize>,
 }
 
 /// Definition 4.2 of one scalar against its reference, with the posterior's summary.
@@ -181,6 +184,9 @@ pub fn run_k(
             n_mse_bound: n_bias * n_bias + n_v,
         });
     }
+    if options.figures_at.contains(&k) {
+        k_figures(&mut posterior, &run, reference, k, options)?;
+    }
     let delta_omega = deltas.pop().expect("two channels");
     let delta_i = deltas.pop().expect("two channels");
     Ok(SweepRecord {
@@ -229,6 +235,72 @@ pub fn shard_of(options: &SweepOptions) -> Vec<(u64, usize)> {
             .map(|(_, p)| p)
             .collect(),
     }
+}
+
+/// δ's band with d0, and the coefficients' marginals with d0's least-squares coefficients, at K.
+fn k_figures(
+    posterior: &mut crate::bayes::CalibrationPosterior,
+    run: &RunOutput,
+    reference: &Reference,
+    k: usize,
+    options: &SweepOptions,
+) -> Result<(), AppError> {
+    std::fs::create_dir_all(&options.out)?;
+    let predictive = crate::app::predictive::posterior_predictive(posterior, &run.chains, 0)?;
+    crate::app::predictive::plot_discrepancy(
+        &options.out.join(format!("fig13-delta-k{k}.png")),
+        &format!(
+            "δ at K = {k} with the reference d₀ ({})",
+            options.coefficient_prior.label()
+        ),
+        &predictive,
+        Some(&reference.discrepancy),
+    )?;
+    let n_x = crate::density::LogDensity::dim(posterior);
+    let mut channels = Vec::new();
+    for (c, name) in ["I", "omega"].iter().enumerate() {
+        let range = posterior
+            .coefficient_range(0, c)
+            .ok_or_else(|| AppError::Numerical("BM2 without coefficients".into()))?;
+        // The basis columns: δ is linear in the coefficients.
+        let m = reference.discrepancy[c].len();
+        let mut basis = nalgebra::DMatrix::zeros(m, range.len());
+        for (col, j) in range.clone().enumerate() {
+            let mut x = vec![0.0; n_x];
+            x[j] = 1.0;
+            let column = posterior.discrepancy(&x, 0, c);
+            for i in 0..m {
+                basis[(i, col)] = column[i];
+            }
+        }
+        let d0 = nalgebra::DVector::from_column_slice(&reference.discrepancy[c]);
+        let least_squares = (basis.transpose() * &basis)
+            .cholesky()
+            .map(|ch| ch.solve(&(basis.transpose() * d0)));
+        let summaries: Vec<&crate::diagnostics::ParameterSummary> = (1..=range.len())
+            .map(|j| {
+                run.summary(&format!("a_{name}.{j}"))
+                    .ok_or_else(|| AppError::Numerical(format!("no summary of a_{name}.{j}")))
+            })
+            .collect::<Result<_, _>>()?;
+        channels.push(plot::CoefficientMarginals {
+            name: (*name).into(),
+            unit: if c == 0 { "A" } else { "rad/s" }.into(),
+            mean: summaries.iter().map(|s| s.mean).collect(),
+            lower: summaries.iter().map(|s| s.q025).collect(),
+            upper: summaries.iter().map(|s| s.q975).collect(),
+            reference: least_squares.map(|v| v.iter().copied().collect()),
+        });
+    }
+    plot::coefficient_marginals(
+        &options.out.join(format!("fig14-coefficients-k{k}.png")),
+        &format!(
+            "Coefficients at K = {k} ({})",
+            options.coefficient_prior.label()
+        ),
+        &channels,
+    )
+    .map_err(|e| AppError::Output(e.to_string()))
 }
 
 /// Every grid point of this shard (all of them without `--shard`), on the paper's set-up with
