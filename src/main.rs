@@ -528,6 +528,11 @@ struct BenchArgs {
     /// Redraw the table, CSV and figures from an earlier run's bench.json (no measuring).
     #[arg(long)]
     from_json: Option<PathBuf>,
+    /// Decay power p of the coefficient prior variance V0/(j+1)^p (0: the paper's prior).
+    #[arg(long, default_value_t = 0.0)]
+    prior_decay: f64,
+    #[arg(long, value_enum, default_value_t = CoefficientFamily::Laplace)]
+    prior_family: CoefficientFamily,
 }
 
 fn bench(args: BenchArgs) -> Result<(), AppError> {
@@ -554,6 +559,11 @@ fn bench(args: BenchArgs) -> Result<(), AppError> {
         json: args.json,
         quiet: args.chains.quiet,
         from_json: args.from_json,
+        coefficient_prior: CoefficientPrior {
+            family: args.prior_family,
+            decay_power: args.prior_decay,
+            ..CoefficientPrior::default()
+        },
     };
     let records = app::bench::bench(&options)?;
     print!("{}", app::bench::format_table(&records));

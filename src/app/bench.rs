@@ -39,6 +39,8 @@ pub struct BenchOptions {
     pub quiet: bool,
     /// Redraw the table and figures from an earlier run's JSON instead of measuring.
     pub from_json: Option<PathBuf>,
+    /// The discrepancy coefficients' prior (§5's decaying variance, or the paper's).
+    pub coefficient_prior: crate::bayes::CoefficientPrior,
 }
 
 impl Default for BenchOptions {
@@ -60,6 +62,7 @@ impl Default for BenchOptions {
             json: None,
             quiet: false,
             from_json: None,
+            coefficient_prior: crate::bayes::CoefficientPrior::default(),
         }
     }
 }
@@ -91,6 +94,13 @@ pub struct BenchRecord {
     /// Sampling time summed over chains (CPU seconds of the sampling phase).
     pub sampling_cpu_s: f64,
     pub divergences: usize,
+    /// min bulk-ESS per second of wall time of the whole run a user waits for: MAP, initial
+    /// points, warm-up and sampling (`wall_s`), beside `min_ess_per_s` of the sampling phase.
+    #[serde(default)]
+    pub min_ess_per_wall_s: f64,
+    /// The coefficient prior the run used (empty in files written before it was recorded).
+    #[serde(default)]
+    pub prior: String,
 }
 
 fn first_attempt(sampler: SamplerKind, options: &BenchOptions) -> ChainSettings {
@@ -179,6 +189,8 @@ fn record(
         warmup_s: run.warmup_seconds,
         sampling_cpu_s,
         divergences: run.divergences,
+        min_ess_per_wall_s: run.min_ess_bulk / run.wall_seconds,
+        prior: crate::bayes::CoefficientPrior::default().label(),
     }
 }
 
@@ -206,8 +218,13 @@ pub fn bench(options: &BenchOptions) -> Result<Vec<BenchRecord>, AppError> {
         ));
     }
     // Every K is checked up front, by the settings' own rule, before any measuring starts.
+    let settings_for = |k: usize| {
+        let mut settings = ModelSettings::bm2(k);
+        settings.coefficient_prior = options.coefficient_prior;
+        settings
+    };
     for &k in &options.ks {
-        ModelSettings::bm2(k)
+        settings_for(k)
             .validate()
             .map_err(|e| AppError::Usage(format!("--k {k}: {e}")))?;
     }
@@ -223,13 +240,16 @@ pub fn bench(options: &BenchOptions) -> Result<Vec<BenchRecord>, AppError> {
     };
     let mut records = Vec::new();
     for &k in &options.ks {
-        let mut posterior = problem.posterior(&ModelSettings::bm2(k))?;
+        let mut posterior = problem.posterior(&settings_for(k))?;
         for &sampler in &options.samplers {
             for &threads in &options.threads {
                 let label = format!("K={k} t={threads}");
                 let (run, chain) =
                     run_until_converged(&mut posterior, sampler, threads, options, &label)?;
-                let r = record(sampler, k, threads, options.chains, &chain, &run);
+                let r = BenchRecord {
+                    prior: options.coefficient_prior.label(),
+                    ..record(sampler, k, threads, options.chains, &chain, &run)
+                };
                 if !options.quiet {
                     eprintln!("{}", format_record(&r));
                 }
@@ -340,11 +360,11 @@ fn write_records(options: &BenchOptions, records: &[BenchRecord]) -> Result<(), 
         .unwrap_or_else(|| options.out.join("bench.json"));
     crate::io::write_atomically(&json_path, json.as_bytes())?;
     let mut csv = String::from(
-        "sampler,k,threads,chains,warmup,draws,min_ess_bulk,min_ess_per_s,min_ess_per_eval,eval_kind,evaluations,max_rhat,converged,lower_bound,wall_s,warmup_s,sampling_cpu_s,divergences\n",
+        "sampler,k,threads,chains,warmup,draws,min_ess_bulk,min_ess_per_s,min_ess_per_eval,eval_kind,evaluations,max_rhat,converged,lower_bound,wall_s,warmup_s,sampling_cpu_s,divergences,min_ess_per_wall_s,prior\n",
     );
     for r in records {
         csv.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},\"{}\"\n",
             r.sampler,
             r.k,
             r.threads,
@@ -362,7 +382,9 @@ fn write_records(options: &BenchOptions, records: &[BenchRecord]) -> Result<(), 
             r.wall_s,
             r.warmup_s,
             r.sampling_cpu_s,
-            r.divergences
+            r.divergences,
+            r.min_ess_per_wall_s,
+            r.prior
         ));
     }
     crate::io::write_atomically(&options.out.join("bench.csv"), csv.as_bytes())?;
