@@ -143,6 +143,12 @@ impl<P: LogDensity> LogDensity for Counted<P> {
     }
 }
 
+impl<P: StartingPoint> StartingPoint for Counted<P> {
+    fn initial_point(&mut self) -> Result<Vec<f64>, DensityError> {
+        self.inner.initial_point()
+    }
+}
+
 impl<P: FisherMetric> FisherMetric for Counted<P> {
     fn fisher_metric(&mut self, x: &[f64], metric: &mut DMatrix<f64>) -> Result<(), DensityError> {
         self.metric_evaluations += 1;

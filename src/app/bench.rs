@@ -98,6 +98,16 @@ pub struct BenchRecord {
     /// points, warm-up and sampling (`wall_s`), beside `min_ess_per_s` of the sampling phase.
     #[serde(default)]
     pub min_ess_per_wall_s: f64,
+    /// Every evaluation of the kind `eval_kind` counts: the MAP's (its Fisher and observed
+    /// metrics counted as one gradient each: each is one sensitivity solve), the warm-up's and
+    /// the sampling's; and min bulk-ESS per one of them.
+    #[serde(default)]
+    pub all_evaluations: u64,
+    #[serde(default)]
+    pub min_ess_per_all_evals: f64,
+    /// Wall seconds of the MAP search.
+    #[serde(default)]
+    pub map_s: f64,
     /// The coefficient prior the run used (empty in files written before it was recorded).
     #[serde(default)]
     pub prior: String,
@@ -169,6 +179,18 @@ fn record(
     } else {
         (run.sampling_density_evaluations, "density")
     };
+    let all_evaluations = if sampler.uses_gradient() {
+        run.map_gradient_evaluations
+            + run.map_metric_evaluations
+            + run.warmup_gradient_evaluations
+            + run.sampling_gradient_evaluations
+    } else {
+        run.map_density_evaluations
+            + run.map_gradient_evaluations
+            + run.map_metric_evaluations
+            + run.warmup_density_evaluations
+            + run.sampling_density_evaluations
+    };
     let ok = converged(run);
     BenchRecord {
         sampler: sampler.name().into(),
@@ -190,6 +212,9 @@ fn record(
         sampling_cpu_s,
         divergences: run.divergences,
         min_ess_per_wall_s: run.min_ess_bulk / run.wall_seconds,
+        all_evaluations,
+        min_ess_per_all_evals: run.min_ess_bulk / all_evaluations.max(1) as f64,
+        map_s: run.map_seconds,
         prior: crate::bayes::CoefficientPrior::default().label(),
     }
 }
@@ -360,11 +385,11 @@ fn write_records(options: &BenchOptions, records: &[BenchRecord]) -> Result<(), 
         .unwrap_or_else(|| options.out.join("bench.json"));
     crate::io::write_atomically(&json_path, json.as_bytes())?;
     let mut csv = String::from(
-        "sampler,k,threads,chains,warmup,draws,min_ess_bulk,min_ess_per_s,min_ess_per_eval,eval_kind,evaluations,max_rhat,converged,lower_bound,wall_s,warmup_s,sampling_cpu_s,divergences,min_ess_per_wall_s,prior\n",
+        "sampler,k,threads,chains,warmup,draws,min_ess_bulk,min_ess_per_s,min_ess_per_eval,eval_kind,evaluations,max_rhat,converged,lower_bound,wall_s,warmup_s,sampling_cpu_s,divergences,min_ess_per_wall_s,all_evaluations,min_ess_per_all_evals,map_s,prior\n",
     );
     for r in records {
         csv.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},\"{}\"\n",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},\"{}\"\n",
             r.sampler,
             r.k,
             r.threads,
@@ -384,6 +409,9 @@ fn write_records(options: &BenchOptions, records: &[BenchRecord]) -> Result<(), 
             r.sampling_cpu_s,
             r.divergences,
             r.min_ess_per_wall_s,
+            r.all_evaluations,
+            r.min_ess_per_all_evals,
+            r.map_s,
             r.prior
         ));
     }
@@ -467,6 +495,12 @@ mod tests {
             sampling_seconds: sampling_s,
             sampling_density_evaluations: 3000 * chains as u64,
             sampling_gradient_evaluations: 2000 * chains as u64,
+            map_seconds: 0.5,
+            map_density_evaluations: 40,
+            map_gradient_evaluations: 60,
+            map_metric_evaluations: 10,
+            warmup_density_evaluations: 500 * chains as u64,
+            warmup_gradient_evaluations: 700 * chains as u64,
             divergences: 0,
             map_log_density: 0.0,
             log_evidence_laplace: 0.0,
@@ -507,6 +541,21 @@ mod tests {
         let metropolis = record(SamplerKind::Metropolis, 9, 1, 4, &settings(), &r);
         assert_eq!(metropolis.eval_kind, "density");
         assert_eq!(metropolis.min_ess_per_eval, 800.0 / 12000.0);
+    }
+
+    #[test]
+    fn the_whole_cost_counts_the_map_and_the_warm_up_too() {
+        let r = run(4, 2.0, 800.0, 1.0);
+        let nuts = record(SamplerKind::NutsDense, 9, 1, 4, &settings(), &r);
+        // MAP: 60 gradients + 10 metrics; warm-up 4 × 700; sampling 4 × 2000.
+        assert_eq!(nuts.all_evaluations, 60 + 10 + 2800 + 8000);
+        assert_eq!(nuts.min_ess_per_all_evals, 800.0 / 10870.0);
+        // Random walks count densities, and the MAP's gradients and metrics as well.
+        let metropolis = record(SamplerKind::Metropolis, 9, 1, 4, &settings(), &r);
+        assert_eq!(metropolis.all_evaluations, 40 + 60 + 10 + 2000 + 12000);
+        // The whole run's wall time (9 s) against the sampling phase's (8 s on one thread).
+        assert_eq!(nuts.min_ess_per_wall_s, 800.0 / 9.0);
+        assert_eq!(nuts.map_s, 0.5);
     }
 
     #[test]

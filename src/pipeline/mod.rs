@@ -157,6 +157,14 @@ pub struct RunOutput {
     pub sampling_seconds: f64,
     pub sampling_density_evaluations: u64,
     pub sampling_gradient_evaluations: u64,
+    /// The whole cost before the draws: the MAP search (wall seconds; its density, gradient
+    /// and metric evaluations) and the warm-up's evaluations summed over chains.
+    pub map_seconds: f64,
+    pub map_density_evaluations: u64,
+    pub map_gradient_evaluations: u64,
+    pub map_metric_evaluations: u64,
+    pub warmup_density_evaluations: u64,
+    pub warmup_gradient_evaluations: u64,
     pub divergences: usize,
     pub map_log_density: f64,
     pub log_evidence_laplace: f64,
@@ -310,6 +318,12 @@ pub fn finish_run(
             .fold(0.0, f64::max),
         sampling_density_evaluations: chains.iter().map(|c| c.sampling_density_evaluations).sum(),
         sampling_gradient_evaluations: chains.iter().map(|c| c.sampling_gradient_evaluations).sum(),
+        map_seconds: 0.0,
+        map_density_evaluations: 0,
+        map_gradient_evaluations: 0,
+        map_metric_evaluations: 0,
+        warmup_density_evaluations: chains.iter().map(|c| c.warmup_density_evaluations).sum(),
+        warmup_gradient_evaluations: chains.iter().map(|c| c.warmup_gradient_evaluations).sum(),
         divergences: chains.iter().map(|c| c.divergences).sum(),
         map_log_density: map.log_density,
         log_evidence_laplace: map.log_evidence_laplace,
@@ -326,7 +340,11 @@ pub fn run_sampler<P: Fittable>(
 ) -> Result<RunOutput, AppError> {
     settings.validate()?;
     let started = Instant::now();
-    let map = map_estimate(posterior)?;
+    // The MAP on a counting copy: the same computation (the posterior's cache changes speed,
+    // never values), with its evaluations counted toward the whole cost.
+    let mut counted = Counted::new(posterior.clone());
+    let map = map_estimate(&mut counted)?;
+    let map_seconds = started.elapsed().as_secs_f64();
     let inits = initial_points(
         posterior,
         &map,
@@ -336,7 +354,13 @@ pub fn run_sampler<P: Fittable>(
     )?;
     let label = format!("{label} {}", settings.sampler.name());
     let chains = dispatch(posterior, &map, &inits, settings, &label)?;
-    Ok(finish_run(settings.sampler.name(), chains, &map, started))
+    Ok(RunOutput {
+        map_seconds,
+        map_density_evaluations: counted.density_evaluations,
+        map_gradient_evaluations: counted.gradient_evaluations,
+        map_metric_evaluations: counted.metric_evaluations,
+        ..finish_run(settings.sampler.name(), chains, &map, started)
+    })
 }
 
 fn dispatch<P: Fittable>(
