@@ -131,6 +131,27 @@ impl ChainArgs {
     fn chains_or(&self, default: usize) -> usize {
         self.chains.unwrap_or(default)
     }
+
+    /// A run of `sampler` with these chains (default 4), seed and quietness.
+    fn run(
+        &self,
+        sampler: app::run::SamplerKind,
+        warmup: usize,
+        draws: usize,
+    ) -> app::run::RunSettings {
+        app::run::RunSettings {
+            sampler,
+            chains: self.chains_or(4),
+            chain: motorcal::sampler::ChainSettings {
+                warmup,
+                draws,
+                keep: None,
+            },
+            seed: self.seed,
+            quiet: self.quiet,
+            ..app::run::RunSettings::default()
+        }
+    }
 }
 
 #[derive(clap::Args)]
@@ -192,21 +213,12 @@ struct RunArgs {
 
 impl RunArgs {
     fn settings(&self) -> app::run::RunSettings {
-        app::run::RunSettings {
-            sampler: self.sampler,
-            chains: self.chains.chains_or(4),
-            chain: motorcal::sampler::ChainSettings {
-                warmup: self.warmup,
-                draws: self.draws,
-                keep: self.keep,
-            },
-            seed: self.chains.seed,
-            threads: self.threads,
-            quiet: self.chains.quiet,
-            save_adaptation: self.save_adaptation.clone(),
-            load_adaptation: self.load_adaptation.clone(),
-            ..app::run::RunSettings::default()
-        }
+        let mut run = self.chains.run(self.sampler, self.warmup, self.draws);
+        run.chain.keep = self.keep;
+        run.threads = self.threads;
+        run.save_adaptation = self.save_adaptation.clone();
+        run.load_adaptation = self.load_adaptation.clone();
+        run
     }
 }
 
@@ -316,18 +328,7 @@ fn sweep(args: SweepArgs, select: bool) -> Result<(), AppError> {
             None => None,
             Some(text) => Some(parse_shard(text)?),
         },
-        run: app::run::RunSettings {
-            sampler: args.sampler,
-            chains: args.chains.chains_or(4),
-            chain: motorcal::sampler::ChainSettings {
-                warmup: args.warmup,
-                draws: args.draws,
-                keep: None,
-            },
-            seed: args.chains.seed,
-            quiet: args.chains.quiet,
-            ..app::run::RunSettings::default()
-        },
+        run: args.chains.run(args.sampler, args.warmup, args.draws),
         out: args.out,
         json: if select { None } else { args.json.clone() },
         figures_at: match &args.figures_at {
@@ -468,18 +469,9 @@ struct DiagnoseArgs {
 }
 
 fn diagnose(args: DiagnoseArgs) -> Result<(), AppError> {
-    let run = app::run::RunSettings {
-        sampler: app::run::SamplerKind::NutsDense,
-        chains: args.chains.chains_or(4),
-        chain: motorcal::sampler::ChainSettings {
-            warmup: args.warmup,
-            draws: args.draws,
-            keep: None,
-        },
-        seed: args.chains.seed,
-        quiet: args.chains.quiet,
-        ..app::run::RunSettings::default()
-    };
+    let run = args
+        .chains
+        .run(app::run::SamplerKind::NutsDense, args.warmup, args.draws);
     let options = app::diagnose::DiagnoseOptions {
         data: args.data,
         model: args.model,

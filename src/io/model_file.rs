@@ -57,6 +57,30 @@ impl ModelFile {
         MotorModel::with_base(self.base, self.motor.clone(), input, self.terms.clone())
     }
 
+    /// Sets a parameter's nominal value by the model's name for it (`R`, `coulomb_friction.T_c`);
+    /// false when the motor has no such parameter or the term is not on.
+    pub fn set_value(&mut self, name: &str, value: f64) -> bool {
+        match name.split_once('.') {
+            Some((term, key)) => {
+                let Some(active) = self.terms.iter_mut().find(|t| t.term.name() == term) else {
+                    return false;
+                };
+                let Some(i) = active.term.params().iter().position(|p| p.key == key) else {
+                    return false;
+                };
+                active.values[i] = value;
+                true
+            }
+            None => match MotorParam::from_key(name) {
+                Some(p) => {
+                    self.motor.set(p, value);
+                    true
+                }
+                None => false,
+            },
+        }
+    }
+
     /// Whether anything needs schema 2 to be written.
     fn needs_schema_2(&self) -> bool {
         !self.terms.is_empty()

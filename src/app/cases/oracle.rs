@@ -14,13 +14,11 @@ use crate::app::problem::Problem;
 use crate::ode::SolverSettings;
 use crate::parameter::Support;
 
-use crate::app::diagnose::problem_with;
+// The starts across a switching time's range are diagnose's: a list of fractions, no scoring.
+use crate::app::diagnose::{BOUNDED_STARTS, problem_with};
 
 pub const RUNNER_UP_MARGIN: f64 = 3.0;
 pub const NONE_MARGIN: f64 = 5.0;
-
-/// Starts tried for a bounded parameter (a switching time), as fractions of its range.
-const BOUNDED_STARTS: [f64; 7] = [0.1, 0.25, 0.4, 0.5, 0.6, 0.75, 0.9];
 
 /// The best weighted fit of `base` with `added` switched on to `target` (channel-major, as the
 /// forward model writes it): SS/σ² at the optimum and the fitted values.

@@ -25,7 +25,7 @@ use crate::parameter::Support;
 /// Starting values tried for a parameter with a bounded support (a time in the record): the
 /// likelihood is multimodal in a switching time, so one start from the prior's median can stop
 /// in the wrong valley.
-const BOUNDED_STARTS: [f64; 7] = [0.1, 0.25, 0.4, 0.5, 0.6, 0.75, 0.9];
+pub const BOUNDED_STARTS: [f64; 7] = [0.1, 0.25, 0.4, 0.5, 0.6, 0.75, 0.9];
 
 /// One fitted candidate model.
 #[derive(Clone, Debug)]
@@ -94,7 +94,7 @@ pub fn n_observations(problem: &Problem) -> usize {
     problem
         .recordings
         .iter()
-        .map(|r| r.n_samples() * r.channels.len().min(2))
+        .map(|r| r.n_samples() * r.channels.len())
         .sum()
 }
 

@@ -25,7 +25,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 pub use candidates::{
-    CandidateFit, answer_params, fit_candidate, fit_candidate_from, problem_with,
+    BOUNDED_STARTS, CandidateFit, answer_params, fit_candidate, fit_candidate_from, problem_with,
 };
 pub use confirm::{Confirmation, importance_evidence};
 pub use fits::{FitSummary, Mismatch, Whiteness, ljung_box};

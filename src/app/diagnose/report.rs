@@ -279,9 +279,10 @@ fn sampled_fits(
                 diagnosis.outputs.push(path.display().to_string());
             }
         }
+        // The posterior means as the model file's values.
         let mut model = after_problem.model.clone();
-        if let Some(summary) = &diagnosis.fit_after {
-            apply_means(&mut model, summary);
+        for (name, &value) in diagnosis.fit_after.iter().flat_map(|f| &f.params_mean) {
+            model.set_value(name, value);
         }
         let path = out.join("model.toml");
         write_model_file(&path, &model)?;
@@ -301,29 +302,6 @@ fn sampled_fits(
         diagnosis.outputs.push(path.display().to_string());
     }
     Ok(())
-}
-
-/// The posterior means as the model file's values.
-fn apply_means(model: &mut crate::io::ModelFile, summary: &FitSummary) {
-    for (name, &value) in &summary.params_mean {
-        match name.split_once('.') {
-            Some((term, key)) => {
-                if let Some(t) = model.terms.iter_mut().find(|t| t.term.name() == term)
-                    && let Some(i) = t.term.params().iter().position(|p| p.key == key)
-                {
-                    t.values[i] = value;
-                }
-            }
-            None => {
-                if let Some(p) = crate::motor::MotorParam::ALL
-                    .iter()
-                    .find(|p| p.key() == name)
-                {
-                    model.motor.set(*p, value);
-                }
-            }
-        }
-    }
 }
 
 fn unit_of(name: &str) -> &'static str {

@@ -9,7 +9,6 @@
 use crate::app::AppError;
 use crate::app::problem::{Problem, recording_from};
 use crate::app::simulate::InputProfile;
-use crate::motor::MotorParam;
 use crate::synthetic::generate;
 
 use super::candidates::{CandidateFit, fit_candidate, problem_with};
@@ -59,24 +58,7 @@ pub fn separating_input(
 pub fn truth_problem(base: &Problem, selected: &CandidateFit) -> Result<Problem, AppError> {
     let mut problem = problem_with(base, &selected.added)?;
     for (name, &value) in &selected.theta {
-        match name.split_once('.') {
-            Some((term, key)) => {
-                if let Some(active) = problem
-                    .model
-                    .terms
-                    .iter_mut()
-                    .find(|t| t.term.name() == term)
-                    && let Some(i) = active.term.params().iter().position(|p| p.key == key)
-                {
-                    active.values[i] = value;
-                }
-            }
-            None => {
-                if let Some(p) = MotorParam::ALL.iter().find(|p| p.key() == name) {
-                    problem.model.motor.set(*p, value);
-                }
-            }
-        }
+        problem.model.set_value(name, value);
     }
     Ok(problem)
 }
