@@ -449,3 +449,29 @@ fn sweep_refuses_impossible_degrees_with_one_line() {
     assert_clean_failure(&run("3,41"), &["--k 41"]);
     assert!(!out.exists());
 }
+
+#[test]
+fn sweep_shard_rule_and_merge_mistakes_are_one_line() {
+    let dir = scratch("merge-bad");
+    let out = dir.join("out");
+    let o = out.to_str().unwrap();
+    assert_clean_failure(
+        &motorcal(&["sweep", "--k", "0", "--shard", "0/3", "--out", o]),
+        &["--shard 0/3"],
+    );
+    assert_clean_failure(
+        &motorcal(&["select-k", "--rule", "coin-toss", "--out", o]),
+        &["--rule coin-toss", "evidence"],
+    );
+    assert_clean_failure(
+        &motorcal(&["select-k", "--shard", "1/2", "--out", o]),
+        &["--shard"],
+    );
+    let part = dir.join("part.json");
+    std::fs::write(&part, "[\n  {\"k\": 3,\n   \"bogus\": 1}\n]\n").unwrap();
+    assert_clean_failure(
+        &motorcal(&["merge", part.to_str().unwrap(), "--out", o]),
+        &["part.json", "line"],
+    );
+    assert!(!out.exists());
+}
