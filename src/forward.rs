@@ -191,6 +191,9 @@ impl ForwardModel {
         let n = self.model.n_states();
         let m = self.times.len();
         let n_channels = self.channels().len();
+        if self.model.drive.is_some() {
+            return self.model.simulate_drive(p, &mut out[..n_channels * m]);
+        }
         let mut y0 = vec![D::from(0.0); n];
         self.model.initial_state(p, &mut y0);
         let mut states = vec![D::from(0.0); n * m];

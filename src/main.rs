@@ -79,6 +79,22 @@ enum Command {
         #[command(subcommand)]
         what: Reproduce,
     },
+    /// A model file's prediction of records it was not fitted to, with the residual RMS per
+    /// channel (the estimation → validation cross-test).
+    Predict {
+        /// The model (e.g. the model.toml that `diagnose --out` writes).
+        #[arg(long)]
+        model: PathBuf,
+        /// A recording; repeat for several.
+        #[arg(long, required = true)]
+        data: Vec<PathBuf>,
+        /// Write measured, predicted and residual per sample as CSV.
+        #[arg(long)]
+        csv: Option<PathBuf>,
+        /// Write the residual table as JSON.
+        #[arg(long)]
+        json: Option<PathBuf>,
+    },
     /// Print ESS, R-hat and MCSE for draws files (CmdStan CSV, or a long chain,draw,… table).
     Summarize {
         #[arg(required = true)]
@@ -671,6 +687,22 @@ fn run(cli: Cli) -> Result<(), AppError> {
                 "realised noise sd: I {:.4} A, omega {:.4} rad/s (seed {seed})",
                 report.realised_noise_sd[0], report.realised_noise_sd[1]
             );
+            Ok(())
+        }
+        Some(Command::Predict {
+            model,
+            data,
+            csv,
+            json,
+        }) => {
+            let options = app::predict::PredictOptions {
+                data,
+                model,
+                csv,
+                json,
+            };
+            let table = app::predict::predict(&options)?;
+            print!("{}", app::predict::format_residuals(&table));
             Ok(())
         }
         Some(Command::Summarize { draws, json }) => {

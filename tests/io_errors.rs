@@ -358,6 +358,7 @@ fn recordings_round_trip_exactly() {
                 ("omega".into(), speed.clone()),
             ],
             voltage: with_voltage.then(|| voltage.clone()),
+            inputs: Vec::new(),
         };
         let path = dir.join(format!("sub/rec_{with_voltage}.csv"));
         write_recording(&path, &rec).unwrap();

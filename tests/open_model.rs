@@ -79,6 +79,7 @@ fn record(dir: &Path, file: &str, terms: Vec<ActiveTerm>, input: VoltageInput, s
             .zip(data.measured.iter().cloned())
             .collect(),
         voltage,
+        inputs: Vec::new(),
     };
     write_recording(&dir.join(file), &recording).unwrap();
 }

@@ -5,6 +5,7 @@ pub mod bench;
 pub mod cases;
 pub mod diagnose;
 pub mod fit;
+pub mod predict;
 pub mod predictive;
 pub mod problem;
 /// The fit pipeline, where the commands have always found it.

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use crate::bayes::{CalibratedParameter, CalibrationPosterior, ModelSettings, Observations};
 use crate::forward::ForwardModel;
-use crate::io::{ModelFile, Recording, read_model_file, read_recording};
+use crate::io::{ModelFile, Recording, read_model_file, read_recording_for};
 use crate::motor::{MotorModel, MotorParameters, VoltageInput};
 use crate::ode::SolverSettings;
 use crate::synthetic::{PaperSetup, SyntheticData, paper_measurements};
@@ -60,7 +60,7 @@ impl Problem {
         let model_file = read_model_file(model)?;
         let recordings = data
             .iter()
-            .map(|path| read_recording(path, &model_file.channels))
+            .map(|path| read_recording_for(path, &model_file.channels, model_file.base))
             .collect::<Result<Vec<_>, _>>()?;
         let label = data
             .iter()
@@ -83,7 +83,7 @@ impl Problem {
     /// The model driven by a recording's input, with the model file's terms.
     pub fn model_for(&self, recording: &Recording) -> Result<MotorModel, AppError> {
         self.model
-            .model(recording.voltage_input())
+            .model_for_recording(recording)
             .map_err(AppError::Usage)
     }
 
@@ -210,6 +210,7 @@ pub fn recording_from(data: &SyntheticData, source: &str, voltage: Option<Vec<f6
             .zip(data.measured.iter().cloned())
             .collect(),
         voltage,
+        inputs: Vec::new(),
     }
 }
 

@@ -24,4 +24,4 @@ pub use model_file::{
     write_model_file,
 };
 pub use model_tables::{CalibrateEntry, DiscrepancyChoice};
-pub use recording::{ChannelMap, Recording, read_recording, write_recording};
+pub use recording::{ChannelMap, Recording, read_recording, read_recording_for, write_recording};

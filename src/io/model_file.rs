@@ -12,8 +12,10 @@ use super::model_tables::{
     CalibrateEntry, DiscrepancyChoice, RawDiscrepancy, parse_calibrate, parse_discrepancy,
     parse_terms, toml_number, write_tables,
 };
-use super::recording::ChannelMap;
-use crate::motor::{ActiveTerm, Base, MotorModel, MotorParam, MotorParameters, VoltageInput};
+use super::recording::{ChannelMap, Recording};
+use crate::motor::{
+    ActiveTerm, Base, DriveSettings, MotorModel, MotorParam, MotorParameters, VoltageInput,
+};
 
 /// The newest model-file format version this build reads and writes. Schema 1 (the motor and
 /// the channels) is still read, and means what it always meant.
@@ -34,6 +36,8 @@ pub struct ModelFile {
     pub calibrate: Option<Vec<CalibrateEntry>>,
     /// `[discrepancy]`; `None` leaves BM1/BM2 and K to the command line's defaults.
     pub discrepancy: Option<DiscrepancyChoice>,
+    /// `[drive]`: how a drive base turns its recorded input into torque.
+    pub drive: DriveSettings,
     pub channels: ChannelMap,
 }
 
@@ -46,6 +50,7 @@ impl Default for ModelFile {
             terms: Vec::new(),
             calibrate: None,
             discrepancy: None,
+            drive: DriveSettings::default(),
             channels: ChannelMap::default(),
         }
     }
@@ -55,6 +60,25 @@ impl ModelFile {
     /// The model driven by `input`, with the file's terms switched on.
     pub fn model(&self, input: VoltageInput) -> Result<MotorModel, String> {
         MotorModel::with_base(self.base, self.motor.clone(), input, self.terms.clone())
+    }
+
+    /// The model of a recording: driven by its voltage, or for a drive base by its recorded
+    /// input through the `[drive]` settings.
+    pub fn model_for_recording(&self, recording: &Recording) -> Result<MotorModel, String> {
+        let model = self.model(recording.voltage_input())?;
+        if !self.base.is_drive() {
+            return Ok(model);
+        }
+        let drive = recording
+            .sampled_drive(self.base, &self.drive)
+            .ok_or_else(|| {
+                format!(
+                    "{}: a {} model needs the record's input column",
+                    recording.source,
+                    self.base.name()
+                )
+            })?;
+        Ok(model.with_drive(drive))
     }
 
     /// Sets a parameter's nominal value by the model's name for it (`R`, `coulomb_friction.T_c`);
@@ -87,6 +111,7 @@ impl ModelFile {
             || self.calibrate.is_some()
             || self.discrepancy.is_some()
             || self.base != Base::VoltageDriven
+            || self.drive != DriveSettings::default()
     }
 }
 
@@ -103,6 +128,7 @@ struct RawModelFile {
     terms: Option<toml::Table>,
     calibrate: Option<toml::Table>,
     discrepancy: Option<RawDiscrepancy>,
+    drive: Option<DriveSettings>,
     #[serde(default)]
     channels: ChannelMap,
 }
@@ -169,6 +195,7 @@ pub fn parse_model_file(text: &str, path: &Path) -> Result<ModelFile, InputError
             ("terms", raw.terms.is_some()),
             ("calibrate", raw.calibrate.is_some()),
             ("discrepancy", raw.discrepancy.is_some()),
+            ("drive", raw.drive.is_some()),
         ] {
             if present {
                 return Err(InputError::new(
@@ -214,8 +241,15 @@ pub fn parse_model_file(text: &str, path: &Path) -> Result<ModelFile, InputError
         terms,
         calibrate,
         discrepancy,
+        drive: raw.drive.clone().unwrap_or_default(),
         channels: raw.channels,
     };
+    if let Err(message) = model.drive.validate(model.base) {
+        let key = message.split(" = ").next().unwrap_or("drive").to_string();
+        return Err(InputError::new(path, message)
+            .at_line_opt(line_of(&key).or_else(|| line_of("drive")))
+            .for_field(key));
+    }
     if let Err(message) = model.motor.validate() {
         // validate() reports "KEY = value ..."; the key tells which line to point at.
         let key = message
@@ -264,11 +298,36 @@ pub fn to_toml_string(model: &ModelFile) -> String {
         model.calibrate.as_deref(),
         model.discrepancy.as_ref(),
     );
+    if model.drive != DriveSettings::default() {
+        let d = &model.drive;
+        out.push_str("\n[drive]\n");
+        if let Some(limit) = d.input_limit {
+            out.push_str(&format!("input_limit = {}\n", toml_number(limit)));
+        }
+        out.push_str(&format!(
+            "position_gain = {}\nvelocity_gain = {}\ndelay_samples = {}\nsubsteps = {}\n",
+            toml_number(d.position_gain),
+            toml_number(d.velocity_gain),
+            d.delay_samples,
+            d.substeps
+        ));
+    }
     let c = &model.channels;
     out.push_str(&format!(
         "\n[channels]\nt = {:?}\nI = {:?}\nomega = {:?}\nU = {:?}\n",
         c.t, c.current, c.speed, c.voltage
     ));
+    let defaults = ChannelMap::default();
+    for (key, value, default) in [
+        ("q", &c.q, &defaults.q),
+        ("q_ref", &c.q_ref, &defaults.q_ref),
+        ("force", &c.force, &defaults.force),
+        ("disturbance", &c.disturbance, &defaults.disturbance),
+    ] {
+        if value != default {
+            out.push_str(&format!("{key} = {value:?}\n"));
+        }
+    }
     out
 }
 

@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 use super::atomic::{with_path, write_atomically};
 use super::error::{InputError, read_text};
 use super::table::{self, Line};
-use crate::motor::{MOTOR_CHANNELS, VoltageInput};
+use crate::motor::{Base, DriveSettings, MOTOR_CHANNELS, SampledDrive, VoltageInput};
 
 /// Which CSV column holds what the model needs. Keys in a model file's `[channels]` table.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -25,6 +25,15 @@ pub struct ChannelMap {
     /// Voltage U [V], optional in the file: without it the model's constant U drives the motor.
     #[serde(rename = "U")]
     pub voltage: String,
+    /// Position q [rad or m] (`position_loop`).
+    pub q: String,
+    /// Reference position of a position loop [rad or m].
+    pub q_ref: String,
+    /// The drive's force or torque, c_g times the controller output [N or N·m] (`position_loop`).
+    pub force: String,
+    /// A disturbance added to the controller output after its saturation (`position_loop`);
+    /// zero when the record has no such column.
+    pub disturbance: String,
 }
 
 impl Default for ChannelMap {
@@ -34,6 +43,10 @@ impl Default for ChannelMap {
             current: "I".into(),
             speed: "omega".into(),
             voltage: "U".into(),
+            q: "q".into(),
+            q_ref: "q_ref".into(),
+            force: "force".into(),
+            disturbance: "disturbance".into(),
         }
     }
 }
@@ -48,6 +61,8 @@ pub struct Recording {
     /// The model's channels by their model names (`I`, `omega`), whatever the file called them.
     pub channels: Vec<(String, Vec<f64>)>,
     pub voltage: Option<Vec<f64>>,
+    /// A drive base's recorded inputs by their model names (`I`; `q_ref`, `disturbance`).
+    pub inputs: Vec<(String, Vec<f64>)>,
 }
 
 impl Recording {
@@ -73,6 +88,54 @@ impl Recording {
         }
     }
 
+    pub fn input(&self, name: &str) -> Option<&[f64]> {
+        self.inputs
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, v)| v.as_slice())
+    }
+
+    /// What a drive base takes from this record: the input series, the disturbance, where the
+    /// axis starts and how fast the record moves; `None` for the voltage-driven motor or a
+    /// record without the base's input.
+    pub fn sampled_drive(&self, base: Base, settings: &DriveSettings) -> Option<SampledDrive> {
+        let largest = |v: &[f64]| v.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        let m = self.n_samples();
+        let (input, disturbance, initial_position, speed_scale) = match base {
+            Base::VoltageDriven => return None,
+            Base::CurrentDriven => (
+                self.input("I")?.to_vec(),
+                vec![0.0; m],
+                0.0,
+                self.channel("omega").map_or(1.0, largest),
+            ),
+            Base::PositionLoop => {
+                let reference = self.input("q_ref")?;
+                let reference_speed = (1..m)
+                    .map(|i| {
+                        ((reference[i] - reference[i - 1]) / (self.time[i] - self.time[i - 1]))
+                            .abs()
+                    })
+                    .fold(0.0f64, f64::max);
+                (
+                    reference.to_vec(),
+                    self.input("disturbance")
+                        .map_or_else(|| vec![0.0; m], |d| d.to_vec()),
+                    self.channel("q").map_or(reference[0], |q| q[0]),
+                    reference_speed,
+                )
+            }
+        };
+        Some(SampledDrive {
+            times: self.time.clone(),
+            input,
+            disturbance,
+            initial_position,
+            speed_scale,
+            settings: settings.clone(),
+        })
+    }
+
     /// The time of the last sample; 0 for an empty recording (which the reader never returns).
     pub fn last_time(&self) -> f64 {
         self.time.last().copied().unwrap_or(0.0)
@@ -86,6 +149,50 @@ impl Recording {
 /// explicitly must exist, since a typo there would otherwise silently drive the motor with the
 /// constant U.
 pub fn read_recording(path: &Path, map: &ChannelMap) -> Result<Recording, InputError> {
+    read_recording_for(path, map, Base::VoltageDriven)
+}
+
+/// Which column plays which part for a base: (model name, column, required).
+struct Roles {
+    outputs: Vec<(&'static str, String)>,
+    inputs: Vec<(&'static str, String, bool)>,
+}
+
+fn roles(map: &ChannelMap, base: Base) -> Roles {
+    match base {
+        Base::VoltageDriven => Roles {
+            outputs: vec![
+                (MOTOR_CHANNELS[0], map.current.clone()),
+                (MOTOR_CHANNELS[1], map.speed.clone()),
+            ],
+            inputs: vec![(
+                "U",
+                map.voltage.clone(),
+                map.voltage != ChannelMap::default().voltage,
+            )],
+        },
+        Base::CurrentDriven => Roles {
+            outputs: vec![("omega", map.speed.clone())],
+            inputs: vec![("I", map.current.clone(), true)],
+        },
+        Base::PositionLoop => Roles {
+            outputs: vec![("q", map.q.clone()), ("force", map.force.clone())],
+            // The disturbance is absent from ordinary records of a rig whose validation record
+            // has it: 0 then, not an error.
+            inputs: vec![
+                ("q_ref", map.q_ref.clone(), true),
+                ("disturbance", map.disturbance.clone(), false),
+            ],
+        },
+    }
+}
+
+/// Reads a recording for a base: the columns its channels and inputs need, named by `map`.
+pub fn read_recording_for(
+    path: &Path,
+    map: &ChannelMap,
+    base: Base,
+) -> Result<Recording, InputError> {
     let text = read_text(path, |text, line, column| {
         table::column_at(text, line, column)
     })?;
@@ -123,16 +230,22 @@ pub fn read_recording(path: &Path, map: &ChannelMap) -> Result<Recording, InputE
             .for_field(wanted)
         })
     };
+    let roles = roles(map, base);
     let t_col = require(&map.t, "time")?;
-    let i_col = require(&map.current, "current")?;
-    let w_col = require(&map.speed, "speed")?;
-    let u_col = if map.voltage == ChannelMap::default().voltage {
-        find(&map.voltage)?
-    } else {
-        Some(require(&map.voltage, "voltage")?)
-    };
-
-    let columns: Vec<usize> = [t_col, i_col, w_col].into_iter().chain(u_col).collect();
+    let mut columns = vec![t_col];
+    for (name, column) in &roles.outputs {
+        columns.push(require(column, &format!("{name} channel"))?);
+    }
+    let mut input_columns: Vec<(&str, Option<usize>)> = Vec::new();
+    for (name, column, required) in &roles.inputs {
+        let found = if *required {
+            Some(require(column, &format!("{name} input"))?)
+        } else {
+            find(column)?
+        };
+        input_columns.push((name, found));
+        columns.extend(found);
+    }
     let mut values: Vec<Vec<f64>> = vec![Vec::new(); columns.len()];
     let mut last_line = header_line;
     for entry in table::lines(&text) {
@@ -191,17 +304,30 @@ pub fn read_recording(path: &Path, map: &ChannelMap) -> Result<Recording, InputE
     let mut values = values.into_iter();
     let mut next = || values.next().unwrap_or_default();
     let time = next();
-    let current = next();
-    let speed = next();
-    let voltage = u_col.map(|_| next());
+    let channels = roles
+        .outputs
+        .iter()
+        .map(|(name, _)| (name.to_string(), next()))
+        .collect();
+    let mut voltage = None;
+    let mut inputs = Vec::new();
+    for (name, found) in input_columns {
+        if found.is_none() {
+            continue;
+        }
+        let series = next();
+        if base == Base::VoltageDriven {
+            voltage = Some(series);
+        } else {
+            inputs.push((name.to_string(), series));
+        }
+    }
     Ok(Recording {
         source: path.display().to_string(),
         time,
-        channels: vec![
-            (MOTOR_CHANNELS[0].to_owned(), current),
-            (MOTOR_CHANNELS[1].to_owned(), speed),
-        ],
+        channels,
         voltage,
+        inputs,
     })
 }
 
@@ -220,6 +346,12 @@ pub fn write_recording(path: &Path, recording: &Recording) -> io::Result<()> {
     if let Some(u) = &recording.voltage {
         columns.push(("U", u));
     }
+    columns.extend(
+        recording
+            .inputs
+            .iter()
+            .map(|(name, v)| (name.as_str(), v.as_slice())),
+    );
     for (name, v) in &columns {
         if v.len() != n {
             return Err(invalid(format!(
@@ -341,6 +473,7 @@ mod tests {
             time: vec![0.0, 1.0],
             channels: vec![("I".into(), vec![1.0, f64::NAN])],
             voltage: None,
+            inputs: Vec::new(),
         };
         let err = write_recording(&dir.join("nan.csv"), &rec).unwrap_err();
         assert!(err.to_string().contains("nan.csv"), "{err}");

@@ -8,10 +8,12 @@
 //! addition to these vectors, never a copy of the motor.
 
 pub mod closed_form;
+mod drive;
 mod input;
 mod parameters;
 pub mod terms;
 
+pub use drive::{DriveSettings, SampledDrive};
 pub use input::VoltageInput;
 pub use parameters::{MotorParam, MotorParameters};
 pub use terms::{Balance, Coefficients, Magnitudes, PRIOR_SHARE, Site, Term};
@@ -28,21 +30,61 @@ impl<D: DualNum<Primitive = f64> + Copy> Scalar for D {}
 /// The channels the motor's measurement map produces, in output order.
 pub const MOTOR_CHANNELS: [&str; 2] = ["I", "omega"];
 
-/// The physics the terms are added to. One kind today; force- or current-driven mechanics and
-/// closed loops are further kinds with their own parameters, states and channels.
+/// The channels of the drive bases.
+pub const CURRENT_DRIVEN_CHANNELS: [&str; 1] = ["omega"];
+pub const POSITION_LOOP_CHANNELS: [&str; 2] = ["q", "force"];
+const DRIVE_STATES: [&str; 2] = ["q", "omega"];
+
+/// The physics the terms are added to.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Base {
     /// L dI/dt = U − R I − c_m ω, J dω/dt = c_g I − d ω, measuring I and ω (eqs. 3–4).
     #[default]
     VoltageDriven,
+    /// J dω/dt = c_g·I − d ω with the recorded current I as input (the drive closes the current
+    /// loop), measuring ω.
+    CurrentDriven,
+    /// The same mechanics on a linear axis (J is a mass, c_g a force per volt) inside a sampled
+    /// position/velocity cascade driven by a reference position; measures q and the force.
+    PositionLoop,
 }
 
 impl Base {
-    pub const ALL: [Base; 1] = [Base::VoltageDriven];
+    pub const ALL: [Base; 3] = [Base::VoltageDriven, Base::CurrentDriven, Base::PositionLoop];
 
     pub fn name(&self) -> &'static str {
         match self {
             Base::VoltageDriven => "voltage_driven",
+            Base::CurrentDriven => "current_driven",
+            Base::PositionLoop => "position_loop",
+        }
+    }
+
+    /// Whether a drive closes the electrical loop (the recorded input drives the mechanics).
+    pub fn is_drive(&self) -> bool {
+        *self != Base::VoltageDriven
+    }
+
+    /// Whether a term applies to this base.
+    pub fn accepts(&self, term: &Term) -> bool {
+        !self.is_drive() || term.mechanical()
+    }
+
+    /// A unit as this base reads it: a linear axis has N for N·m, m for rad, kg for kg·m².
+    pub fn unit(&self, unit: &'static str) -> &'static str {
+        if *self != Base::PositionLoop {
+            return unit;
+        }
+        match unit {
+            "kg·m²" => "kg",
+            "N·m/A" => "N/V",
+            "N·m" => "N",
+            "N·m·s/rad" => "N·s/m",
+            "N·m·s²/rad²" => "N·s²/m²",
+            "rad/s" => "m/s",
+            "rad" => "m",
+            "A" => "V",
+            other => other,
         }
     }
 
@@ -53,12 +95,15 @@ impl Base {
     pub fn state_names(&self) -> &'static [&'static str] {
         match self {
             Base::VoltageDriven => &MOTOR_CHANNELS,
+            Base::CurrentDriven | Base::PositionLoop => &DRIVE_STATES,
         }
     }
 
     pub fn channels(&self) -> &'static [&'static str] {
         match self {
             Base::VoltageDriven => &MOTOR_CHANNELS,
+            Base::CurrentDriven => &CURRENT_DRIVEN_CHANNELS,
+            Base::PositionLoop => &POSITION_LOOP_CHANNELS,
         }
     }
 }
@@ -85,6 +130,8 @@ pub struct MotorModel {
     pub base: Base,
     pub nominal: MotorParameters,
     pub input: VoltageInput,
+    /// The recorded input and settings of a drive base (`None` for the voltage-driven motor).
+    pub drive: Option<SampledDrive>,
     terms: Vec<ActiveTerm>,
     /// Offsets of each term's parameters in the parameter vector (one more than terms).
     param_offsets: Vec<usize>,
@@ -128,6 +175,14 @@ impl MotorModel {
             });
         }
         terms.sort_by_key(|t| t.term.rank());
+        if let Some(t) = terms.iter().find(|t| !base.accepts(&t.term)) {
+            return Err(format!(
+                "term {} acts on the electrical equation or the current sensor, which a {} \
+                 model does not have",
+                t.term.name(),
+                base.name()
+            ));
+        }
         for pair in terms.windows(2) {
             if pair[0].term.name() == pair[1].term.name() {
                 return Err(format!("term {} is listed twice", pair[0].term.name()));
@@ -159,6 +214,7 @@ impl MotorModel {
                 ..nominal
             },
             input,
+            drive: None,
             terms,
             param_offsets,
             state_offsets,
@@ -196,16 +252,50 @@ impl MotorModel {
         self.parameter_names().iter().position(|n| n == name)
     }
 
+    /// The model driven by a record's sampled input (a drive base).
+    pub fn with_drive(self, drive: SampledDrive) -> Self {
+        Self {
+            drive: Some(drive),
+            ..self
+        }
+    }
+
+    /// A drive base's channels at its record's samples (channel-major), with the sampled-input
+    /// integrator; the record's times are the drive's.
+    pub fn simulate_drive<D: Scalar>(
+        &self,
+        p: &[D],
+        out: &mut [D],
+    ) -> Result<crate::ode::SolverStats, crate::ode::OdeError> {
+        let drive = self.drive.as_ref().expect("simulate_drive needs a drive");
+        drive::simulate(self, drive, p, out)
+    }
+
     /// The scales the default priors are drawn to, for a recording of the given length.
     pub fn magnitudes(&self, duration: f64) -> Magnitudes {
         let m = &self.nominal;
+        let sane = |v: f64| if v.is_finite() && v > 0.0 { v } else { 1.0 };
+        if let Some(drive) = &self.drive {
+            // What the drive can deliver (c_g times its input limit) plays the stall torque's
+            // part, the record's largest speed the no-load speed's.
+            let current = sane(drive.input_scale());
+            let torque = sane(m.torque_constant * current);
+            let speed = sane(drive.speed_scale);
+            return Magnitudes {
+                voltage: 1.0,
+                current,
+                speed,
+                torque,
+                energy: sane(torque * speed * duration),
+                duration: sane(duration),
+            };
+        }
         let held_max = match &self.input {
             VoltageInput::Constant => m.voltage.abs(),
             VoltageInput::Held { values, .. } => values.iter().fold(0.0f64, |a, v| a.max(v.abs())),
         };
         // A degenerate nominal model (U = 0, c_m = 0) would give zero or infinite scales; one
         // unit is then as good a scale as any, and finite.
-        let sane = |v: f64| if v.is_finite() && v > 0.0 { v } else { 1.0 };
         let voltage = sane(held_max);
         let current = sane(voltage / m.resistance);
         let speed = sane(voltage / m.back_emf_constant);
@@ -226,13 +316,19 @@ impl MotorModel {
     pub fn parameter_specs(&self, magnitudes: &Magnitudes) -> Vec<ParameterSpec> {
         let mut specs: Vec<ParameterSpec> = MotorParam::ALL
             .iter()
-            .map(|&p| base_spec(p, self.nominal.get(p), magnitudes))
+            .map(|&p| {
+                let spec = base_spec(p, self.nominal.get(p), magnitudes);
+                ParameterSpec {
+                    unit: self.base.unit(spec.unit),
+                    ..spec
+                }
+            })
             .collect();
         for t in &self.terms {
             for (decl, &value) in t.term.params().iter().zip(&t.values) {
                 specs.push(ParameterSpec {
                     name: format!("{}.{}", t.term.name(), decl.key),
-                    unit: decl.unit,
+                    unit: self.base.unit(decl.unit),
                     nominal: value,
                     support: (decl.support)(magnitudes),
                     default_prior: (decl.prior)(magnitudes),
@@ -399,7 +495,7 @@ fn base_spec(p: MotorParam, nominal: f64, m: &Magnitudes) -> ParameterSpec {
     }
 }
 
-fn base_coefficients<D: Scalar>(p: &[D]) -> Coefficients<D> {
+pub(crate) fn base_coefficients<D: Scalar>(p: &[D]) -> Coefficients<D> {
     use MotorParam::*;
     Coefficients {
         resistance: p[Resistance as usize],

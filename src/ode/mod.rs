@@ -4,8 +4,10 @@
 //! run take the same steps and the dual part is the exact derivative of the numerical solution.
 
 mod dopri5;
+mod sampled;
 
 pub use dopri5::solve;
+pub use sampled::{HeldInputSystem, solve_sampled};
 
 use serde::{Deserialize, Serialize};
 

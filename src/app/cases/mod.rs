@@ -87,6 +87,7 @@ fn nominal_problem(input: &VoltageInput, times: &[f64]) -> Problem {
                 ("omega".into(), vec![0.0; times.len()]),
             ],
             voltage,
+            inputs: Vec::new(),
         }],
         model: ModelFile::default(),
         reference: None,
@@ -397,6 +398,7 @@ fn write_case(
             VoltageInput::Held { values, .. } => Some(values.clone()),
             VoltageInput::Constant => None,
         },
+        inputs: Vec::new(),
     };
     let mut params = BTreeMap::new();
     params.insert("R".to_string(), r_true);

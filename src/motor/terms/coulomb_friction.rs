@@ -24,6 +24,7 @@ fn prior(m: &Magnitudes) -> Prior {
 impl PhysicsTerm for CoulombFriction {
     const NAME: &'static str = "coulomb_friction";
     const EQUATION: &'static str = "J dω/dt += −T_c·tanh(ω/ω_s)";
+    const MECHANICAL: bool = true;
     const PARAMS: &'static [TermParam] = &[TermParam {
         key: "T_c",
         unit: "N·m",

@@ -19,6 +19,7 @@ fn prior(m: &Magnitudes) -> Prior {
 impl PhysicsTerm for LoadTorque {
     const NAME: &'static str = "load_torque";
     const EQUATION: &'static str = "J dω/dt += −T_0";
+    const MECHANICAL: bool = true;
     const PARAMS: &'static [TermParam] = &[TermParam {
         key: "T_0",
         unit: "N·m",

@@ -124,6 +124,9 @@ pub trait PhysicsTerm: Sized + Clone + std::fmt::Debug + PartialEq {
     const PARAMS: &'static [TermParam];
     const SETTINGS: &'static [TermSetting] = &[];
     const STATES: &'static [TermState] = &[];
+    /// Whether the term acts on the mechanical equation alone, so that it also applies to the
+    /// drive bases, where the electrical equation and the current sensor are not modelled.
+    const MECHANICAL: bool = false;
 
     /// The term with its settings (in the order of `SETTINGS`), or why they are invalid.
     fn with_settings(settings: &[f64]) -> Result<Self, String>;
@@ -259,6 +262,10 @@ macro_rules! terms {
 
             pub fn setting_decls(&self) -> &'static [TermSetting] {
                 match self { $(Term::$variant(_) => <$variant as PhysicsTerm>::SETTINGS),* }
+            }
+
+            pub fn mechanical(&self) -> bool {
+                match self { $(Term::$variant(_) => <$variant as PhysicsTerm>::MECHANICAL),* }
             }
 
             pub fn states(&self) -> &'static [TermState] {

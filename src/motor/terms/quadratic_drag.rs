@@ -17,6 +17,7 @@ fn prior(m: &Magnitudes) -> Prior {
 impl PhysicsTerm for QuadraticDrag {
     const NAME: &'static str = "quadratic_drag";
     const EQUATION: &'static str = "J dω/dt += −k_q·ω|ω|";
+    const MECHANICAL: bool = true;
     const PARAMS: &'static [TermParam] = &[TermParam {
         key: "k_q",
         unit: "N·m·s²/rad²",

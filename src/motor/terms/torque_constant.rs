@@ -9,6 +9,7 @@ pub struct TorqueConstant;
 impl PhysicsTerm for TorqueConstant {
     const NAME: &'static str = "torque_constant";
     const EQUATION: &'static str = "c_g → c_g·(1 + k)";
+    const MECHANICAL: bool = true;
     const PARAMS: &'static [TermParam] = &[relative_param("k")];
 
     fn with_settings(_: &[f64]) -> Result<Self, String> {

@@ -17,6 +17,7 @@ fn prior(m: &Magnitudes) -> Prior {
 impl PhysicsTerm for ViscousFriction {
     const NAME: &'static str = "viscous_friction";
     const EQUATION: &'static str = "d → d + Dd";
+    const MECHANICAL: bool = true;
     const PARAMS: &'static [TermParam] = &[TermParam {
         key: "Dd",
         unit: "N·m·s/rad",

@@ -1,0 +1,252 @@
+//! Mechanics driven by a drive that closes the electrical loop itself: the recorded current (or
+//! force command) is the input of J dω/dt = c_g·u − d·ω + Σ torque, and the electrical equation
+//! is not observable. Two bases use it:
+//!
+//! - `current_driven`: u is a recorded current, held between samples; the model measures ω.
+//! - `position_loop`: u is the output of a sampled cascade controller acting on the simulated
+//!   position (a P position loop feeding a P velocity loop, as the EMPS benchmark documents:
+//!   u_k = k_p·k_v·(q_ref,k − q_k) − k_v·v_k with v_k the backward difference of the two-sample
+//!   mean of q, saturated at ±`input_limit`, plus an optional recorded disturbance added after
+//!   the saturation, applied `delay_samples` later). The model measures q and the force
+//!   c_g·u_k. The loop tracks so well that position hides the model error at the µm level; the
+//!   controller output is where it shows.
+//!
+//! Both are integrated with fixed steps aligned to the samples ([`crate::ode::solve_sampled`]):
+//! the input changes at every sample of a 1 kHz record.
+
+use serde::{Deserialize, Serialize};
+
+use super::terms::{Balance, Site};
+use super::{Base, MotorModel, MotorParam, Scalar, base_coefficients};
+use crate::ode::{HeldInputSystem, OdeError, SolverStats, solve_sampled};
+
+/// The `[drive]` table of a model file: how the drive turns its input into torque.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct DriveSettings {
+    /// The largest input the drive passes (A for a current, V for a controller output): the
+    /// controller's saturation, and with c_g the torque scale the default priors are drawn to.
+    /// `None`: the largest recorded input.
+    pub input_limit: Option<f64>,
+    /// k_p of the position loop [1/s] (`position_loop` only).
+    pub position_gain: f64,
+    /// k_v of the velocity loop [input per unit speed] (`position_loop` only).
+    pub velocity_gain: f64,
+    /// Samples between the controller computing an output and the drive applying it.
+    pub delay_samples: usize,
+    /// Fourth-order steps per sample interval.
+    pub substeps: usize,
+}
+
+impl Default for DriveSettings {
+    fn default() -> Self {
+        Self {
+            input_limit: None,
+            position_gain: 0.0,
+            velocity_gain: 0.0,
+            delay_samples: 0,
+            substeps: 1,
+        }
+    }
+}
+
+impl DriveSettings {
+    pub fn validate(&self, base: Base) -> Result<(), String> {
+        if let Some(limit) = self.input_limit
+            && !(limit > 0.0 && limit.is_finite())
+        {
+            return Err(format!(
+                "drive.input_limit = {limit} must be a positive number"
+            ));
+        }
+        if !(1..=64).contains(&self.substeps) {
+            return Err(format!(
+                "drive.substeps = {} must be between 1 and 64",
+                self.substeps
+            ));
+        }
+        if base == Base::PositionLoop {
+            for (key, v) in [
+                ("position_gain", self.position_gain),
+                ("velocity_gain", self.velocity_gain),
+            ] {
+                if !(v > 0.0 && v.is_finite()) {
+                    return Err(format!(
+                        "drive.{key} = {v} must be a positive number for a position_loop base"
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// What a record gives the drive: its sample times, the input series (the current for
+/// `current_driven`, the reference position for `position_loop`), a disturbance added after
+/// the saturation (zeros when not recorded), where the axis starts, and its speed scale.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct SampledDrive {
+    pub times: Vec<f64>,
+    pub input: Vec<f64>,
+    pub disturbance: Vec<f64>,
+    pub initial_position: f64,
+    /// The largest speed of the record (measured, or of the reference): what "fast" means.
+    pub speed_scale: f64,
+    pub settings: DriveSettings,
+}
+
+impl SampledDrive {
+    /// The input limit: declared, or the largest recorded input.
+    pub fn input_scale(&self) -> f64 {
+        self.settings.input_limit.unwrap_or_else(|| {
+            self.input
+                .iter()
+                .fold(0.0f64, |a, v| a.max(v.abs()))
+                .max(f64::MIN_POSITIVE)
+        })
+    }
+}
+
+/// q' = ω and J ω' = c_g·u − d·ω + Σ torque, with the model's terms.
+struct Mechanics<'a, D> {
+    model: &'a MotorModel,
+    p: &'a [D],
+    /// c_g after the terms that rescale it, d, 1/J.
+    torque_constant: D,
+    viscous_friction: D,
+    inverse_inertia: D,
+}
+
+impl<D: Scalar> HeldInputSystem<D> for Mechanics<'_, D> {
+    fn n_states(&self) -> usize {
+        self.model.n_states()
+    }
+
+    fn rhs(&self, t: f64, y: &[D], input: D, dy: &mut [D]) {
+        let model = self.model;
+        let speed = y[1];
+        let site = |k: usize| Site {
+            t,
+            segment_start: t,
+            current: input,
+            speed,
+            params: &self.p[model.param_offsets[k]..model.param_offsets[k + 1]],
+            states: &y[model.state_offsets[k]..model.state_offsets[k + 1]],
+        };
+        let mut balance = Balance {
+            resistance: D::from(0.0),
+            torque_constant: self.torque_constant,
+            voltage: D::from(0.0),
+            torque: D::from(0.0),
+        };
+        for (k, active) in model.terms.iter().enumerate() {
+            active.term.contribute(&site(k), &mut balance);
+        }
+        dy[0] = speed;
+        dy[1] = (balance.torque_constant * input - self.viscous_friction * speed + balance.torque)
+            * self.inverse_inertia;
+        for (k, active) in model.terms.iter().enumerate() {
+            let states = model.state_offsets[k]..model.state_offsets[k + 1];
+            if !states.is_empty() {
+                active.term.derivatives(&site(k), &balance, &mut dy[states]);
+            }
+        }
+    }
+}
+
+/// The channels of a drive-base model at the record's samples, channel-major (`out[c·M + i]`).
+pub(super) fn simulate<D: Scalar>(
+    model: &MotorModel,
+    drive: &SampledDrive,
+    p: &[D],
+    out: &mut [D],
+) -> Result<SolverStats, OdeError> {
+    let mut coefficients = base_coefficients(p);
+    for (k, t) in model.terms.iter().enumerate() {
+        t.term.adjust(
+            &p[model.param_offsets[k]..model.param_offsets[k + 1]],
+            &mut coefficients,
+        );
+    }
+    let system = Mechanics {
+        model,
+        p,
+        torque_constant: coefficients.torque_constant,
+        viscous_friction: coefficients.viscous_friction,
+        inverse_inertia: coefficients.inverse_inertia,
+    };
+    let n = model.n_states();
+    let m = drive.times.len();
+    let mut y0 = vec![D::from(0.0); n];
+    model.initial_state(p, &mut y0);
+    y0[0] = D::from(drive.initial_position);
+    let mut states = vec![D::from(0.0); n * m];
+    let substeps = drive.settings.substeps;
+    let stats = match model.base {
+        Base::PositionLoop => {
+            let delay = drive.settings.delay_samples;
+            // The controller's outputs as it computed them, and the positions it has seen.
+            let mut outputs: Vec<D> = Vec::with_capacity(m);
+            let mut seen: Vec<D> = Vec::with_capacity(m);
+            let stats = solve_sampled(
+                &system,
+                &y0,
+                &drive.times,
+                substeps,
+                |k, y| {
+                    seen.push(y[0]);
+                    outputs.push(controller_output(drive, &seen, k));
+                    outputs[k.saturating_sub(delay)]
+                },
+                &mut states,
+            )?;
+            // The last sample's output, computed like the others (nothing applies it).
+            seen.push(states[(m - 1) * n]);
+            outputs.push(controller_output(drive, &seen, m - 1));
+            let gain = p[MotorParam::TorqueConstant as usize];
+            for i in 0..m {
+                out[i] = states[i * n];
+                out[m + i] = outputs[i] * gain;
+            }
+            stats
+        }
+        _ => {
+            let stats = solve_sampled(
+                &system,
+                &y0,
+                &drive.times,
+                substeps,
+                |k, _| D::from(drive.input[k]),
+                &mut states,
+            )?;
+            for i in 0..m {
+                out[i] = states[i * n + 1];
+            }
+            stats
+        }
+    };
+    Ok(stats)
+}
+
+/// The cascade's output at sample k from the positions seen up to k: the velocity estimate is
+/// the backward difference of the two-sample mean, (q_k − q_{k−2}) / 2h; the output saturates
+/// (no derivative there) and the recorded disturbance adds after the saturation.
+fn controller_output<D: Scalar>(drive: &SampledDrive, seen: &[D], k: usize) -> D {
+    let s = &drive.settings;
+    let limit = drive.input_scale();
+    let h = if k == 0 {
+        drive.times.get(1).map_or(1.0, |t1| t1 - drive.times[0])
+    } else {
+        drive.times[k] - drive.times[k - 1]
+    };
+    let back = |j: usize| seen[k.saturating_sub(j)];
+    let speed = (back(0) - back(2)) / (2.0 * h);
+    let raw =
+        (-back(0) + drive.input[k]) * (s.position_gain * s.velocity_gain) - speed * s.velocity_gain;
+    let saturated = if raw.re().abs() > limit {
+        D::from(limit.copysign(raw.re()))
+    } else {
+        raw
+    };
+    saturated + drive.disturbance[k]
+}
