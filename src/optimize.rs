@@ -212,6 +212,7 @@ pub fn find_map<P: FisherMetric>(
     let mut log_density = density.log_density_and_gradient(&x0, &mut gradient)?;
     let mut newton_decrement = f64::INFINITY;
     for _ in 0..50 {
+        let previous_decrement = newton_decrement;
         density.fisher_metric(&x0, &mut hessian)?;
         let chol = cholesky_factor(&hessian)?;
         let step = chol.solve(&DVector::from_column_slice(&gradient));
@@ -220,6 +221,13 @@ pub fn find_map<P: FisherMetric>(
             .max(0.0)
             .sqrt();
         if newton_decrement < 1e-9 {
+            break;
+        }
+        // On a long record the log density is ~10⁵ and its rounding ~10⁻¹¹: once the predicted
+        // gain ½·decrement² is down at that level and no longer falls quadratically, further
+        // steps only chase rounding (each with a line search of up to 30 solves).
+        let at_rounding = newton_decrement * newton_decrement < 1e-12 * log_density.abs().max(1.0);
+        if at_rounding && newton_decrement > 0.1 * previous_decrement {
             break;
         }
         let mut scale = 1.0;

@@ -12,6 +12,9 @@ use crate::synthetic::{PaperSetup, SyntheticData, paper_measurements};
 
 use super::AppError;
 
+/// ε of a drive base's vague noise prior InvGamma(ε, ε²) (see [`Problem::posterior`]).
+const VAGUE_NOISE_SHAPE: f64 = 1e-3;
+
 /// What is known only in a synthetic experiment: the truth behind the data.
 #[derive(Clone, Debug)]
 pub struct Reference {
@@ -87,6 +90,21 @@ impl Problem {
             .map_err(AppError::Usage)
     }
 
+    /// A drive base's speed scale: the largest over its records; `None` for the voltage-driven
+    /// motor.
+    pub fn speed_scale(&self) -> Result<Option<f64>, AppError> {
+        if !self.model.base.is_drive() {
+            return Ok(None);
+        }
+        let mut largest = 0.0f64;
+        for r in &self.recordings {
+            if let Some(drive) = &self.model_for(r)?.drive {
+                largest = largest.max(drive.speed_scale);
+            }
+        }
+        Ok(Some(largest))
+    }
+
     /// What is calibrated: the `[calibrate]` table's parameters in the order of the model's
     /// parameter vector, or R alone.
     pub fn calibrated_names(&self) -> Result<Vec<String>, AppError> {
@@ -148,6 +166,24 @@ impl Problem {
     }
 
     pub fn posterior(&self, settings: &ModelSettings) -> Result<CalibrationPosterior, AppError> {
+        // The paper's InvGamma(1, 1) on σ suits its channels (A and rad/s, σ of order 1). A
+        // drive base measures in whatever unit the rig has (µm of position on a ball screw,
+        // where it would put −10⁵ nats on the truth), so its noise prior is the vague
+        // InvGamma(ε, ε²), flat in log σ over every scale a record can have.
+        let vague;
+        let settings = if self.model.base.is_drive()
+            && settings.noise_prior_shape == ModelSettings::default().noise_prior_shape
+            && settings.noise_prior_scale == ModelSettings::default().noise_prior_scale
+        {
+            vague = ModelSettings {
+                noise_prior_shape: VAGUE_NOISE_SHAPE,
+                noise_prior_scale: VAGUE_NOISE_SHAPE * VAGUE_NOISE_SHAPE,
+                ..settings.clone()
+            };
+            &vague
+        } else {
+            settings
+        };
         let forwards = self.forward_models(SolverSettings::default())?;
         let mut records = Vec::new();
         for (forward, recording) in forwards.into_iter().zip(&self.recordings) {

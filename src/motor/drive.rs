@@ -175,74 +175,58 @@ pub(super) fn simulate<D: Scalar>(
         viscous_friction: coefficients.viscous_friction,
         inverse_inertia: coefficients.inverse_inertia,
     };
-    let n = model.n_states();
     let m = drive.times.len();
-    let mut y0 = vec![D::from(0.0); n];
+    let mut y0 = vec![D::from(0.0); model.n_states()];
     model.initial_state(p, &mut y0);
     y0[0] = D::from(drive.initial_position);
-    let mut states = vec![D::from(0.0); n * m];
     let substeps = drive.settings.substeps;
-    let stats = match model.base {
+    match model.base {
         Base::PositionLoop => {
             let delay = drive.settings.delay_samples;
-            // The controller's outputs as it computed them, and the positions it has seen.
-            let mut outputs: Vec<D> = Vec::with_capacity(m);
-            let mut seen: Vec<D> = Vec::with_capacity(m);
-            let stats = solve_sampled(
-                &system,
-                &y0,
-                &drive.times,
-                substeps,
-                |k, y| {
-                    seen.push(y[0]);
-                    outputs.push(controller_output(drive, &seen, k));
-                    outputs[k.saturating_sub(delay)]
-                },
-                &mut states,
-            )?;
-            // The last sample's output, computed like the others (nothing applies it).
-            seen.push(states[(m - 1) * n]);
-            outputs.push(controller_output(drive, &seen, m - 1));
             let gain = p[MotorParam::TorqueConstant as usize];
-            for i in 0..m {
-                out[i] = states[i * n];
-                out[m + i] = outputs[i] * gain;
-            }
-            stats
+            let (positions, forces) = out.split_at_mut(m);
+            let limit = drive.input_scale();
+            // The last three positions the controller saw, and its last `delay + 1` outputs.
+            let mut seen = [D::from(drive.initial_position); 3];
+            let mut pending = vec![D::from(0.0); delay + 1];
+            solve_sampled(&system, &y0, &drive.times, substeps, |k, y| {
+                seen = [y[0], seen[0], seen[1]];
+                if k == 0 {
+                    seen = [y[0]; 3];
+                }
+                let output = controller_output(drive, limit, &seen, k);
+                positions[k] = y[0];
+                forces[k] = output * gain;
+                // Before the first output has come through the delay, the first is held.
+                if k == 0 {
+                    pending.fill(output);
+                }
+                pending.rotate_right(1);
+                pending[0] = output;
+                pending[delay]
+            })
         }
-        _ => {
-            let stats = solve_sampled(
-                &system,
-                &y0,
-                &drive.times,
-                substeps,
-                |k, _| D::from(drive.input[k]),
-                &mut states,
-            )?;
-            for i in 0..m {
-                out[i] = states[i * n + 1];
-            }
-            stats
-        }
-    };
-    Ok(stats)
+        _ => solve_sampled(&system, &y0, &drive.times, substeps, |k, y| {
+            out[k] = y[1];
+            D::from(drive.input[k])
+        }),
+    }
 }
 
-/// The cascade's output at sample k from the positions seen up to k: the velocity estimate is
-/// the backward difference of the two-sample mean, (q_k − q_{k−2}) / 2h; the output saturates
-/// (no derivative there) and the recorded disturbance adds after the saturation.
-fn controller_output<D: Scalar>(drive: &SampledDrive, seen: &[D], k: usize) -> D {
+/// The cascade's output at sample k from the last three positions seen (q_k, q_{k−1}, q_{k−2}):
+/// the velocity estimate is the backward difference of the two-sample mean, (q_k − q_{k−2}) / 2h;
+/// the output saturates (no derivative there) and the recorded disturbance adds after the
+/// saturation.
+fn controller_output<D: Scalar>(drive: &SampledDrive, limit: f64, seen: &[D; 3], k: usize) -> D {
     let s = &drive.settings;
-    let limit = drive.input_scale();
     let h = if k == 0 {
         drive.times.get(1).map_or(1.0, |t1| t1 - drive.times[0])
     } else {
         drive.times[k] - drive.times[k - 1]
     };
-    let back = |j: usize| seen[k.saturating_sub(j)];
-    let speed = (back(0) - back(2)) / (2.0 * h);
+    let speed = (seen[0] - seen[2]) / (2.0 * h);
     let raw =
-        (-back(0) + drive.input[k]) * (s.position_gain * s.velocity_gain) - speed * s.velocity_gain;
+        (-seen[0] + drive.input[k]) * (s.position_gain * s.velocity_gain) - speed * s.velocity_gain;
     let saturated = if raw.re().abs() > limit {
         D::from(limit.copysign(raw.re()))
     } else {

@@ -62,13 +62,14 @@ pub fn problem_with(base: &Problem, added: &[String]) -> Result<Problem, AppErro
             prior: None,
         }],
     };
+    let speed_scale = base.speed_scale()?;
     for name in added {
         if problem.model.terms.iter().any(|t| t.term.name() == name) {
             return Err(AppError::Usage(format!(
                 "the model already has the term {name}"
             )));
         }
-        let term = Term::named(name).ok_or_else(|| {
+        let term = Term::named_for(name, speed_scale).ok_or_else(|| {
             AppError::Usage(format!(
                 "unknown candidate '{name}' (known: {})",
                 Term::NAMES.join(", ")

@@ -70,6 +70,8 @@ pub struct DiagnoseOptions {
 /// The candidates to rank: the given names (checked) or every term the model lacks.
 fn candidate_names(problem: &Problem, given: Option<&[String]>) -> Result<Vec<String>, AppError> {
     let present = |name: &str| problem.model.terms.iter().any(|t| t.term.name() == name);
+    let base = problem.model.base;
+    let applies = |name: &str| Term::named(name).is_some_and(|t| base.accepts(&t));
     match given {
         Some(names) => {
             for n in names {
@@ -84,12 +86,19 @@ fn candidate_names(problem: &Problem, given: Option<&[String]>) -> Result<Vec<St
                         "--candidates: the model already has {n}"
                     )));
                 }
+                if !applies(n) {
+                    return Err(AppError::Usage(format!(
+                        "--candidates: {n} acts on the electrical equation or the current \
+                         sensor, which a {} model does not have",
+                        base.name()
+                    )));
+                }
             }
             Ok(names.to_vec())
         }
         None => Ok(Term::NAMES
             .iter()
-            .filter(|n| !present(n))
+            .filter(|n| !present(n) && applies(n))
             .map(|n| n.to_string())
             .collect()),
     }

@@ -36,6 +36,7 @@ impl PhysicsTerm for CoulombFriction {
         key: "omega_s",
         unit: "rad/s",
         default: 1.0,
+        speed_share: Some(0.01),
     }];
 
     fn with_settings(s: &[f64]) -> Result<Self, String> {

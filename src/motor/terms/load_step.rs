@@ -64,6 +64,7 @@ impl PhysicsTerm for LoadStep {
         key: "width",
         unit: "s",
         default: 1e-3,
+        speed_share: None,
     }];
 
     fn with_settings(s: &[f64]) -> Result<Self, String> {

@@ -74,6 +74,10 @@ pub struct TermSetting {
     pub key: &'static str,
     pub unit: &'static str,
     pub default: f64,
+    /// On a drive base, the default is instead this share of the record's largest speed: a
+    /// smoothing speed must be small against the speeds the rig runs at, in whatever unit
+    /// (1e-3 m/s on a ball screw, not 1 rad/s).
+    pub speed_share: Option<f64>,
 }
 
 /// A state a term adds to the ODE, with its initial value.
@@ -325,8 +329,20 @@ terms!(
 impl Term {
     /// The term with its default settings.
     pub fn named(name: &str) -> Option<Term> {
+        Term::named_for(name, None)
+    }
+
+    /// The term with its default settings for a rig whose largest speed is `speed_scale` (a
+    /// drive base), or the fixed defaults (`None`).
+    pub fn named_for(name: &str, speed_scale: Option<f64>) -> Option<Term> {
         let (_, settings) = Term::declarations(name)?;
-        let defaults: Vec<f64> = settings.iter().map(|s| s.default).collect();
+        let defaults: Vec<f64> = settings
+            .iter()
+            .map(|s| match (s.speed_share, speed_scale) {
+                (Some(share), Some(speed)) if speed > 0.0 && speed.is_finite() => share * speed,
+                _ => s.default,
+            })
+            .collect();
         Term::from_name(name, &defaults).and_then(|t| t.ok())
     }
 }

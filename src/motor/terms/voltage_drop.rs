@@ -34,6 +34,7 @@ impl PhysicsTerm for VoltageDrop {
         key: "I_s",
         unit: "A",
         default: 1.0,
+        speed_share: None,
     }];
 
     fn with_settings(s: &[f64]) -> Result<Self, String> {
