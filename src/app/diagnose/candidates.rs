@@ -17,6 +17,7 @@ use std::collections::BTreeMap;
 use crate::app::AppError;
 use crate::app::problem::Problem;
 use crate::bayes::{CalibrationPosterior, ModelSettings};
+use crate::density::LogDensity;
 use crate::io::CalibrateEntry;
 use crate::motor::{ActiveTerm, Term};
 use crate::optimize::{MapEstimate, MapSettings, find_map};
@@ -26,6 +27,12 @@ use crate::parameter::Support;
 /// likelihood is multimodal in a switching time, so one start from the prior's median can stop
 /// in the wrong valley.
 pub const BOUNDED_STARTS: [f64; 7] = [0.1, 0.25, 0.4, 0.5, 0.6, 0.75, 0.9];
+
+/// How many starts a long record's MAP search keeps (the best by their log density).
+pub const LONG_RECORD_STARTS: usize = 2;
+
+/// Multiples of the prior's median at which a one-sided added parameter is also started.
+pub const POSITIVE_START_FACTORS: [f64; 1] = [4.0];
 
 /// One fitted candidate model.
 #[derive(Clone, Debug)]
@@ -114,7 +121,7 @@ pub fn fit_candidate_from(
 ) -> Result<CandidateFit, AppError> {
     let problem = problem_with(base, added)?;
     let mut posterior = problem.posterior(&ModelSettings::bm1())?;
-    let map = best_map(&mut posterior, warm)?;
+    let map = best_map(&mut posterior, warm, super::fits::uses_laplace(&problem))?;
     let log_likelihood = posterior.log_likelihood(&map.x)?;
     let added_names: Vec<String> = posterior
         .calibrated()
@@ -162,6 +169,7 @@ pub fn fit_candidate_from(
 fn best_map(
     posterior: &mut CalibrationPosterior,
     warm: Option<&CandidateFit>,
+    long_record: bool,
 ) -> Result<MapEstimate, AppError> {
     let mut start = posterior.initial_point()?;
     let known = |name: &str| warm.and_then(|w| w.theta.get(name).copied());
@@ -184,12 +192,42 @@ fn best_map(
         })
         .collect();
     let mut starts = vec![start.clone()];
+    // A one-sided parameter (a friction, a drag) started at its prior's median can end on its
+    // bound when the other parameters first move to absorb its effect (J and d of a model that
+    // lacks friction); starting it at a few times its median as well reaches the mode from
+    // the other side.
+    for (i, c) in posterior.calibrated().iter().enumerate() {
+        if matches!(c.support, Support::Positive)
+            && known(&c.name).is_none()
+            && c.name.contains('.')
+        {
+            for factor in POSITIVE_START_FACTORS {
+                let mut s = start.clone();
+                s[i] = c.to_unconstrained(c.start * factor);
+                starts.push(s);
+            }
+        }
+    }
     for &(i, lower, upper) in &bounded {
         for f in BOUNDED_STARTS {
             let mut s = start.clone();
             s[i] = posterior.calibrated()[i].to_unconstrained(lower + f * (upper - lower));
             starts.push(s);
         }
+    }
+    if long_record && starts.len() > LONG_RECORD_STARTS {
+        // A MAP search on 20 000 samples costs seconds; the starts' own log densities (one
+        // plain solve each) pick the valleys worth searching.
+        let mut scored: Vec<(f64, Vec<f64>)> = starts
+            .into_iter()
+            .map(|s| (posterior.log_density(&s).unwrap_or(f64::NEG_INFINITY), s))
+            .collect();
+        scored.sort_by(|a, b| b.0.total_cmp(&a.0));
+        starts = scored
+            .into_iter()
+            .take(LONG_RECORD_STARTS)
+            .map(|(_, s)| s)
+            .collect();
     }
     let mut best: Option<MapEstimate> = None;
     let mut last_error = None;

@@ -203,7 +203,9 @@ pub fn diagnose(options: &DiagnoseOptions) -> Result<Diagnosis, AppError> {
         .map_err(|e| AppError::Usage(format!("--k {k}: {e}")))?;
     let candidates = candidate_names(&problem, options.candidates.as_deref())?;
     let ranking = rank(&problem, &candidates)?;
+    let ranking_s = started.elapsed().as_secs_f64();
     let (selected_set, selected_fit) = forward_selection(&problem, &ranking, &candidates)?;
+    let selection_s = started.elapsed().as_secs_f64();
     report::assemble(
         &problem,
         options,
@@ -213,5 +215,6 @@ pub fn diagnose(options: &DiagnoseOptions) -> Result<Diagnosis, AppError> {
         selected_set,
         selected_fit,
         started,
+        [ranking_s, selection_s],
     )
 }

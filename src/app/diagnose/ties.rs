@@ -26,6 +26,9 @@ pub fn separating_input(
     seed: u64,
 ) -> Result<Option<InputProfile>, AppError> {
     let truth = truth_problem(base, selected)?;
+    if base.model.base.is_drive() {
+        return reversed_record(base, &truth, selected, other, noise_sd, threshold, seed);
+    }
     for input in INPUTS {
         let recording = &base.recordings[0];
         let model_file = &truth.model;
@@ -51,6 +54,65 @@ pub fn separating_input(
         }
     }
     Ok(None)
+}
+
+/// A drive base's experiment: the first record run the other way (its current negated, or its
+/// reference mirrored about the start), simulated by the selected model with noise at the
+/// fitted σ. Reversal is the experiment that tells a friction, which turns with the motion,
+/// from a constant load, which does not.
+#[allow(clippy::too_many_arguments)]
+fn reversed_record(
+    base: &Problem,
+    truth: &Problem,
+    selected: &CandidateFit,
+    other: &str,
+    noise_sd: &[f64],
+    threshold: f64,
+    seed: u64,
+) -> Result<Option<InputProfile>, AppError> {
+    use rand::SeedableRng;
+    use rand_distr::{Distribution, Normal};
+
+    let mut reversed = base.recordings[0].clone();
+    reversed.source = "simulated reversed record".into();
+    for (name, series) in reversed.inputs.iter_mut() {
+        let start = series.first().copied().unwrap_or(0.0);
+        for v in series.iter_mut() {
+            *v = match name.as_str() {
+                "q_ref" => 2.0 * start - *v,
+                _ => -*v,
+            };
+        }
+    }
+    let simulated = Problem {
+        label: reversed.source.clone(),
+        recordings: vec![reversed],
+        model: truth.model.clone(),
+        reference: None,
+    };
+    let predicted = crate::app::predict::predict_records(&simulated)?;
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed ^ 0x7e7e_5eed);
+    let mut recording = simulated.recordings[0].clone();
+    for ((_, values), (c, (_, _, model))) in recording
+        .channels
+        .iter_mut()
+        .zip(predicted[0].channels.iter().enumerate())
+    {
+        let noise = Normal::new(0.0, noise_sd[c].max(f64::MIN_POSITIVE))
+            .map_err(|e| AppError::Numerical(e.to_string()))?;
+        for (v, g) in values.iter_mut().zip(model) {
+            *v = g + noise.sample(&mut rng);
+        }
+    }
+    let experiment = Problem {
+        label: recording.source.clone(),
+        recordings: vec![recording],
+        model: base.model.clone(),
+        reference: None,
+    };
+    let a = fit_candidate(&experiment, &selected.added)?;
+    let b = fit_candidate(&experiment, &[other.to_string()])?;
+    Ok((a.score - b.score > threshold).then_some(InputProfile::Reversal))
 }
 
 /// The user's model with the selected terms at their estimates and the calibrated base
