@@ -5,11 +5,11 @@ nutpie: tune + draw (compilation excluded), CPU time of its process (`cpu_sample
 Each nutpie seed is paired with the motorcal runs whose time span overlaps its sampling (from
 times.log); the median over all motorcal runs of the session is printed too.
 
-usage: python3 ratio.py
+usage: python3 ratio.py [DIR]   (DIR: the folder of the files; this script's own by default)
 """
-import json, math, os, statistics
+import json, math, os, statistics, sys
 
-HERE = os.path.dirname(os.path.abspath(__file__))
+HERE = sys.argv[1] if len(sys.argv) > 1 else os.path.dirname(os.path.abspath(__file__))
 
 
 def sig2(x):
