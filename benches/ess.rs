@@ -67,9 +67,9 @@ impl RunStats {
         let chain_seconds = run
             .chains
             .iter()
-            .map(|c| c.warmup_seconds + c.sampling_seconds)
+            .map(|c| c.warmup_cpu_seconds + c.sampling_cpu_seconds)
             .sum();
-        let sampling_seconds = run.chains.iter().map(|c| c.sampling_seconds).sum();
+        let sampling_seconds = run.chains.iter().map(|c| c.sampling_cpu_seconds).sum();
         let evaluations = run
             .chains
             .iter()

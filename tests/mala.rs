@@ -504,6 +504,41 @@ fn fisher_mala_evaluates_the_metric_once_per_transition_at_the_proposal() {
     assert_eq!(density.density_evaluations, 0);
 }
 
+#[test]
+fn the_driver_reports_fisher_malas_metrics_and_cpu_time_per_phase() {
+    let settings = ChainSettings {
+        warmup: 200,
+        draws: 300,
+        keep: None,
+    };
+    let mut rng = chain_rng(34, 0);
+    let (out, _) = run_chain(
+        one_d_target(),
+        FisherMala::new(1.0).unwrap(),
+        FisherMalaAdaptation::default(),
+        &[1.0],
+        &settings,
+        &mut rng,
+        0,
+        None,
+    )
+    .unwrap();
+    // One metric per gradient; the warm-up's include the initial point's.
+    assert_eq!(out.warmup_metric_evaluations, 201);
+    assert_eq!(out.warmup_gradient_evaluations, 201);
+    assert_eq!(out.sampling_metric_evaluations, 300);
+    assert_eq!(out.sampling_gradient_evaluations, 300);
+    for (cpu, wall) in [
+        (out.warmup_cpu_seconds, out.warmup_wall_seconds),
+        (out.sampling_cpu_seconds, out.sampling_wall_seconds),
+    ] {
+        assert!(
+            cpu >= 0.0 && cpu <= wall + 0.01,
+            "CPU {cpu} s, wall {wall} s"
+        );
+    }
+}
+
 // ---------------------------------------------------------------------------------------------
 // The paper's BM2(K = 3) posterior.
 

@@ -81,11 +81,23 @@ fn wasserstein_distance_is_symmetric_and_sees_a_spread() {
     assert!((ab - 0.25).abs() < 1e-3, "{ab}");
 }
 
-/// The JSON a run writes, with the wall times (the one field a rerun cannot repeat) zeroed.
+/// The JSON a run writes, with the times and the speeds per second (the fields a rerun cannot
+/// repeat) zeroed.
 fn without_wall_times(records: &[motorcal::app::sweep::SweepRecord]) -> String {
+    fn zero_times(v: &mut serde_json::Value) {
+        if let Some(map) = v.as_object_mut() {
+            for (key, value) in map.iter_mut() {
+                if key.ends_with("_s") {
+                    *value = serde_json::json!(0.0);
+                } else {
+                    zero_times(value);
+                }
+            }
+        }
+    }
     let mut v = serde_json::to_value(records).unwrap();
     for r in v.as_array_mut().unwrap() {
-        r["wall_s"] = serde_json::json!(0.0);
+        zero_times(r);
     }
     serde_json::to_string_pretty(&v).unwrap()
 }

@@ -18,6 +18,7 @@ use crate::optimize::{MapEstimate, MapSettings, find_map};
 use crate::sampler::NoAdaptation;
 use crate::sampler::adapt::{AdaptationState, HamiltonianKernel, WindowedAdaptation};
 use crate::sampler::adaptive_metropolis::{AdaptiveMetropolis, HaarioAdaptation};
+use crate::sampler::clock::Stopwatch;
 use crate::sampler::driver::chain_rng;
 use crate::sampler::fisher_mala::{FisherMala, FisherMalaAdaptation};
 use crate::sampler::hmc::{Hmc, HmcSettings};
@@ -28,6 +29,9 @@ use crate::sampler::nuts::{Nuts, NutsSettings};
 use crate::sampler::{Adaptation, ChainOutput, ChainSettings, Kernel, run_chains};
 
 use crate::app::AppError;
+
+pub mod cost;
+pub use cost::{RunCost, ratio_2sf};
 
 /// What the pipeline can fit: a log density with a gradient and a Gauss–Newton metric that
 /// knows a sensible point to start a search from, and that chains can clone.
@@ -152,19 +156,29 @@ pub struct RunOutput {
     pub summaries: Vec<ParameterSummary>,
     pub max_rhat: f64,
     pub min_ess_bulk: f64,
+    /// Wall time of the whole run: MAP, initial points, chains, diagnostics.
     pub wall_seconds: f64,
-    pub warmup_seconds: f64,
-    pub sampling_seconds: f64,
-    pub sampling_density_evaluations: u64,
-    pub sampling_gradient_evaluations: u64,
-    /// The whole cost before the draws: the MAP search (wall seconds; its density, gradient
-    /// and metric evaluations) and the warm-up's evaluations summed over chains.
-    pub map_seconds: f64,
+    /// The MAP search and the initial points drawn around it, on the calling thread.
+    pub map_wall_seconds: f64,
+    pub map_cpu_seconds: f64,
+    /// Warm-up and sampling, each summed over chains, wall time and CPU time alike: the
+    /// phases then add up to the chains' whole cost whatever the thread count (a maximum over
+    /// chains would not, and with fewer threads than chains a chain's wall time includes
+    /// waiting for a core, which its CPU time does not).
+    pub warmup_wall_seconds: f64,
+    pub warmup_cpu_seconds: f64,
+    pub sampling_wall_seconds: f64,
+    pub sampling_cpu_seconds: f64,
+    /// Evaluations of each phase, summed over chains; a Fisher metric is a "metric".
     pub map_density_evaluations: u64,
     pub map_gradient_evaluations: u64,
     pub map_metric_evaluations: u64,
     pub warmup_density_evaluations: u64,
     pub warmup_gradient_evaluations: u64,
+    pub warmup_metric_evaluations: u64,
+    pub sampling_density_evaluations: u64,
+    pub sampling_gradient_evaluations: u64,
+    pub sampling_metric_evaluations: u64,
     pub divergences: usize,
     pub map_log_density: f64,
     pub log_evidence_laplace: f64,
@@ -311,19 +325,21 @@ pub fn finish_run(
         max_rhat,
         min_ess_bulk,
         wall_seconds: started.elapsed().as_secs_f64(),
-        warmup_seconds: chains.iter().map(|c| c.warmup_seconds).fold(0.0, f64::max),
-        sampling_seconds: chains
-            .iter()
-            .map(|c| c.sampling_seconds)
-            .fold(0.0, f64::max),
-        sampling_density_evaluations: chains.iter().map(|c| c.sampling_density_evaluations).sum(),
-        sampling_gradient_evaluations: chains.iter().map(|c| c.sampling_gradient_evaluations).sum(),
-        map_seconds: 0.0,
+        map_wall_seconds: 0.0,
+        map_cpu_seconds: 0.0,
+        warmup_wall_seconds: chains.iter().map(|c| c.warmup_wall_seconds).sum(),
+        warmup_cpu_seconds: chains.iter().map(|c| c.warmup_cpu_seconds).sum(),
+        sampling_wall_seconds: chains.iter().map(|c| c.sampling_wall_seconds).sum(),
+        sampling_cpu_seconds: chains.iter().map(|c| c.sampling_cpu_seconds).sum(),
         map_density_evaluations: 0,
         map_gradient_evaluations: 0,
         map_metric_evaluations: 0,
         warmup_density_evaluations: chains.iter().map(|c| c.warmup_density_evaluations).sum(),
         warmup_gradient_evaluations: chains.iter().map(|c| c.warmup_gradient_evaluations).sum(),
+        warmup_metric_evaluations: chains.iter().map(|c| c.warmup_metric_evaluations).sum(),
+        sampling_density_evaluations: chains.iter().map(|c| c.sampling_density_evaluations).sum(),
+        sampling_gradient_evaluations: chains.iter().map(|c| c.sampling_gradient_evaluations).sum(),
+        sampling_metric_evaluations: chains.iter().map(|c| c.sampling_metric_evaluations).sum(),
         divergences: chains.iter().map(|c| c.divergences).sum(),
         map_log_density: map.log_density,
         log_evidence_laplace: map.log_evidence_laplace,
@@ -340,22 +356,24 @@ pub fn run_sampler<P: Fittable>(
 ) -> Result<RunOutput, AppError> {
     settings.validate()?;
     let started = Instant::now();
+    let map_watch = Stopwatch::start();
     // The MAP on a counting copy: the same computation (the posterior's cache changes speed,
     // never values), with its evaluations counted toward the whole cost.
     let mut counted = Counted::new(posterior.clone());
     let map = map_estimate(&mut counted)?;
-    let map_seconds = started.elapsed().as_secs_f64();
     let inits = initial_points(
-        posterior,
+        &mut counted,
         &map,
         settings.chains,
         settings.init_dispersion,
         settings.seed,
     )?;
+    let map_time = map_watch.elapsed();
     let label = format!("{label} {}", settings.sampler.name());
     let chains = dispatch(posterior, &map, &inits, settings, &label)?;
     Ok(RunOutput {
-        map_seconds,
+        map_wall_seconds: map_time.wall_seconds,
+        map_cpu_seconds: map_time.cpu_seconds,
         map_density_evaluations: counted.density_evaluations,
         map_gradient_evaluations: counted.gradient_evaluations,
         map_metric_evaluations: counted.metric_evaluations,

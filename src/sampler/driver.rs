@@ -9,6 +9,7 @@ use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use super::clock::Stopwatch;
 use super::{Adaptation, Info, Kernel, State};
 use crate::density::{Counted, DensityError, LogDensity};
 
@@ -77,13 +78,19 @@ pub struct ChainOutput {
     /// Kept draws in the sampler's unconstrained coordinates.
     pub unconstrained: Vec<Vec<f64>>,
     pub records: Vec<DrawRecord>,
-    pub warmup_seconds: f64,
-    pub sampling_seconds: f64,
+    /// Wall time and CPU time (of the thread that ran the chain) of each phase, in seconds.
+    pub warmup_wall_seconds: f64,
+    pub warmup_cpu_seconds: f64,
+    pub sampling_wall_seconds: f64,
+    pub sampling_cpu_seconds: f64,
     pub warmup_density_evaluations: u64,
     pub warmup_gradient_evaluations: u64,
+    /// Fisher metrics evaluated (Fisher-MALA evaluates one per proposal).
+    pub warmup_metric_evaluations: u64,
     /// Evaluations during the sampling phase (all draws, kept or not).
     pub sampling_density_evaluations: u64,
     pub sampling_gradient_evaluations: u64,
+    pub sampling_metric_evaluations: u64,
     pub uses_gradient: bool,
     pub divergences: usize,
     /// Mean accept_stat over the sampling phase.
@@ -118,6 +125,8 @@ where
     A: Adaptation<K>,
 {
     settings.validate().map_err(DensityError::fatal)?;
+    // The warm-up's time includes the initial point's evaluation, as its counts do.
+    let warmup_watch = Stopwatch::start();
     let mut density = Counted::new(density);
     let names = density.output_names();
     let mut state: State = kernel.init_state(&mut density, init)?;
@@ -129,7 +138,6 @@ where
     let total = settings.warmup + settings.draws;
     let reporter = Reporter::new(progress, total);
 
-    let started = Instant::now();
     let mut divergences_warmup = 0usize;
     for iteration in 0..settings.warmup {
         let info = kernel.step(&mut density, &mut state, rng)?;
@@ -138,9 +146,12 @@ where
         reporter.tick(iteration, &info, divergences_warmup, "warm-up");
     }
     adaptation.finish(&mut kernel);
-    let warmup_seconds = started.elapsed().as_secs_f64();
-    let (warmup_density_evaluations, warmup_gradient_evaluations) =
-        (density.density_evaluations, density.gradient_evaluations);
+    let warmup = warmup_watch.elapsed();
+    let (warmup_density_evaluations, warmup_gradient_evaluations, warmup_metric_evaluations) = (
+        density.density_evaluations,
+        density.gradient_evaluations,
+        density.metric_evaluations,
+    );
 
     let first_kept = settings.draws - settings.kept();
     let mut draws = Vec::with_capacity(settings.kept());
@@ -150,7 +161,7 @@ where
     let mut accept_sum = 0.0;
     let mut constrained = Vec::new();
     let mut last_step_size = f64::NAN;
-    let sampling_started = Instant::now();
+    let sampling_watch = Stopwatch::start();
     for i in 0..settings.draws {
         let info = kernel.step(&mut density, &mut state, rng)?;
         divergences += info.divergent as usize;
@@ -172,7 +183,7 @@ where
         }
         reporter.tick(settings.warmup + i, &info, divergences, "sampling");
     }
-    let sampling_seconds = sampling_started.elapsed().as_secs_f64();
+    let sampling = sampling_watch.elapsed();
     reporter.finish(divergences);
     let output = ChainOutput {
         chain,
@@ -181,12 +192,16 @@ where
         draws,
         unconstrained,
         records,
-        warmup_seconds,
-        sampling_seconds,
+        warmup_wall_seconds: warmup.wall_seconds,
+        warmup_cpu_seconds: warmup.cpu_seconds,
+        sampling_wall_seconds: sampling.wall_seconds,
+        sampling_cpu_seconds: sampling.cpu_seconds,
         warmup_density_evaluations,
         warmup_gradient_evaluations,
+        warmup_metric_evaluations,
         sampling_density_evaluations: density.density_evaluations - warmup_density_evaluations,
         sampling_gradient_evaluations: density.gradient_evaluations - warmup_gradient_evaluations,
+        sampling_metric_evaluations: density.metric_evaluations - warmup_metric_evaluations,
         uses_gradient: kernel.uses_gradient(),
         divergences,
         mean_accept_stat: accept_sum / settings.draws as f64,

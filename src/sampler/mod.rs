@@ -7,6 +7,7 @@
 
 pub mod adapt;
 pub mod adaptive_metropolis;
+pub mod clock;
 pub mod driver;
 pub mod fisher_mala;
 pub mod hamiltonian;

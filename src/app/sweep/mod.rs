@@ -14,7 +14,7 @@ use crate::app::problem::{Problem, Reference};
 use crate::bayes::{CoefficientPrior, ModelSettings};
 use crate::diagnostics::ParameterSummary;
 use crate::evidence::importance_sampling;
-use crate::pipeline::{RunOutput, RunSettings, map_estimate, run_sampler};
+use crate::pipeline::{RunCost, RunOutput, RunSettings, map_estimate, run_sampler};
 use crate::plot::{self, KSeries};
 
 /// Draws used for δ's pointwise moments: plenty for a mean and a variance per sample time.
@@ -83,7 +83,12 @@ pub struct SweepRecord {
     pub min_ess_bulk: f64,
     pub min_ess_tail: f64,
     pub divergences: usize,
+    /// Wall time of the whole K: the run, the evidence, the statistics and figures.
     pub wall_s: f64,
+    /// The run's cost by phase, and min bulk-ESS per CPU second and per evaluation of the
+    /// sampling phase and of the whole cost (absent from files written before it was).
+    #[serde(default)]
+    pub cost: RunCost,
     /// The log evidence p(y | K) by importance sampling from the Laplace approximation, and
     /// the Laplace value itself (which misses the coefficient prior's kink at 0).
     pub evidence: crate::evidence::Evidence,
@@ -209,6 +214,7 @@ pub fn run_k(
             .fold(f64::INFINITY, f64::min),
         divergences: run.divergences,
         wall_s,
+        cost: RunCost::of(&run, options.run.sampler.uses_gradient()),
         evidence,
         sigma_draws: [pooled(&run, "sigma_I"), pooled(&run, "sigma_omega")],
     })
@@ -367,7 +373,9 @@ pub fn write_outputs(
          delta_I_nbias,delta_I_nv,delta_I_nmse,delta_I_nmse_bound,\
          delta_omega_nbias,delta_omega_nv,delta_omega_nmse,delta_omega_nmse_bound,\
          max_rhat,min_ess_bulk,min_ess_tail,divergences,wall_s,\
-         log_evidence,log_evidence_se,log_evidence_ess,log_evidence_laplace\n",
+         log_evidence,log_evidence_se,log_evidence_ess,log_evidence_laplace,\
+         map_cpu_s,warmup_cpu_s,sampling_cpu_s,total_cpu_s,evaluations,all_evaluations,\
+         min_ess_per_s,min_ess_per_total_s,min_ess_per_eval,min_ess_per_all_evals\n",
     );
     for r in records {
         let s = |x: &ScalarStats| {
@@ -379,7 +387,7 @@ pub fn write_outputs(
         let d =
             |x: &DiscrepancyStats| format!("{},{},{},{}", x.n_bias, x.n_v, x.n_mse, x.n_mse_bound);
         csv.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
             r.k,
             r.prior,
             r.data_seed,
@@ -407,6 +415,7 @@ pub fn write_outputs(
             r.evidence.standard_error,
             r.evidence.effective_draws,
             r.evidence.log_evidence_laplace,
+            cost_columns(&r.cost),
         ));
     }
     let path = options.out.join("sweep.csv");
@@ -426,6 +435,22 @@ pub fn write_outputs(
         written.extend(figures(records, options)?);
     }
     Ok(written)
+}
+
+fn cost_columns(c: &RunCost) -> String {
+    format!(
+        "{},{},{},{},{},{},{},{},{},{}",
+        c.map_cpu_s,
+        c.warmup_cpu_s,
+        c.sampling_cpu_s,
+        c.total_cpu_s,
+        c.evaluations,
+        c.all_evaluations,
+        c.min_ess_per_s,
+        c.min_ess_per_total_s,
+        c.min_ess_per_eval,
+        c.min_ess_per_all_evals
+    )
 }
 
 fn figures(records: &[SweepRecord], options: &SweepOptions) -> Result<Vec<PathBuf>, AppError> {

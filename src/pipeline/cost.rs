@@ -1,0 +1,198 @@
+//! What a run cost, counted whole: every speed figure per second (or evaluation) of the
+//! sampling phase alone and per second (or evaluation) of everything before the draws too — the
+//! MAP, the initial points, the warm-up. The report of `bench` and `sweep`.
+
+use serde::{Deserialize, Serialize};
+
+use super::RunOutput;
+
+/// The cost of one run and min bulk-ESS per unit of it. Seconds are wall time (`*_wall_s`,
+/// `wall_s`) or CPU time of the threads that did the work (`*_cpu_s`); the chains' phases are
+/// summed over chains. Reading older files, `map_s` is `map_wall_s` and `warmup_s` is
+/// `warmup_wall_s` (then the maximum over chains, not yet the sum).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct RunCost {
+    /// Wall time of the whole run a user waits for: MAP, initial points, warm-up, sampling.
+    pub wall_s: f64,
+    /// The MAP search and the initial points.
+    #[serde(alias = "map_s")]
+    pub map_wall_s: f64,
+    pub map_cpu_s: f64,
+    #[serde(alias = "warmup_s")]
+    pub warmup_wall_s: f64,
+    pub warmup_cpu_s: f64,
+    pub sampling_wall_s: f64,
+    pub sampling_cpu_s: f64,
+    /// `map_cpu_s + warmup_cpu_s + sampling_cpu_s`.
+    pub total_cpu_s: f64,
+    /// `gradient` for gradient samplers, `density` for the random walks.
+    pub eval_kind: String,
+    /// Evaluations of `eval_kind` in the sampling phase.
+    pub evaluations: u64,
+    /// Every evaluation: the MAP's (densities too for the random walks), the initial points',
+    /// the warm-up's and the sampling's, with each Fisher or observed-information metric
+    /// (the MAP's Hessian, Fisher-MALA's one per proposal) counted as one gradient: each
+    /// needs the same sensitivities.
+    pub all_evaluations: u64,
+    /// min bulk-ESS per CPU second of the sampling phase.
+    pub min_ess_per_s: f64,
+    /// min bulk-ESS per CPU second of the whole cost (`total_cpu_s`).
+    pub min_ess_per_total_s: f64,
+    /// min bulk-ESS per second of the whole run's wall time (`wall_s`).
+    pub min_ess_per_wall_s: f64,
+    /// min bulk-ESS per evaluation of the sampling phase, and per one of all of them.
+    pub min_ess_per_eval: f64,
+    pub min_ess_per_all_evals: f64,
+}
+
+impl RunCost {
+    pub fn of(run: &RunOutput, uses_gradient: bool) -> Self {
+        let metrics = run.map_metric_evaluations
+            + run.warmup_metric_evaluations
+            + run.sampling_metric_evaluations;
+        let (evaluations, all_evaluations, eval_kind) = if uses_gradient {
+            (
+                run.sampling_gradient_evaluations,
+                run.map_gradient_evaluations
+                    + run.warmup_gradient_evaluations
+                    + run.sampling_gradient_evaluations
+                    + metrics,
+                "gradient",
+            )
+        } else {
+            (
+                run.sampling_density_evaluations,
+                run.map_density_evaluations
+                    + run.map_gradient_evaluations
+                    + run.warmup_density_evaluations
+                    + run.sampling_density_evaluations
+                    + metrics,
+                "density",
+            )
+        };
+        let total_cpu_s = run.map_cpu_seconds + run.warmup_cpu_seconds + run.sampling_cpu_seconds;
+        let ess = run.min_ess_bulk;
+        Self {
+            wall_s: run.wall_seconds,
+            map_wall_s: run.map_wall_seconds,
+            map_cpu_s: run.map_cpu_seconds,
+            warmup_wall_s: run.warmup_wall_seconds,
+            warmup_cpu_s: run.warmup_cpu_seconds,
+            sampling_wall_s: run.sampling_wall_seconds,
+            sampling_cpu_s: run.sampling_cpu_seconds,
+            total_cpu_s,
+            eval_kind: eval_kind.into(),
+            evaluations,
+            all_evaluations,
+            min_ess_per_s: ess / run.sampling_cpu_seconds,
+            min_ess_per_total_s: ess / total_cpu_s,
+            min_ess_per_wall_s: ess / run.wall_seconds,
+            min_ess_per_eval: ess / evaluations.max(1) as f64,
+            min_ess_per_all_evals: ess / all_evaluations.max(1) as f64,
+        }
+    }
+}
+
+/// A ratio to two significant figures ("28×", "0.54×", "7100×"): reruns move speed ratios by
+/// ~20%, so a third figure would be noise.
+pub fn ratio_2sf(x: f64) -> String {
+    if !x.is_finite() || x <= 0.0 {
+        return format!("{x}");
+    }
+    let digits = 1 - x.log10().floor() as i32;
+    let rounded = {
+        let scale = 10f64.powi(digits);
+        (x * scale).round() / scale
+    };
+    // Rounding can carry into a new leading digit (9.96 → 10): then one decimal fewer.
+    let digits = 1 - rounded.log10().floor() as i32;
+    format!("{rounded:.*}", digits.max(0) as usize)
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+
+    /// Four chains: MAP 0.5 s CPU (60 gradients, 10 metrics, 40 densities); each chain
+    /// 0.25 s of warm-up (700 gradients, 300 metrics) and 2 s of sampling (2000 gradients,
+    /// 1000 metrics), summed over chains.
+    pub(crate) fn run(min_ess: f64) -> RunOutput {
+        RunOutput {
+            sampler: "x".into(),
+            chains: Vec::new(),
+            summaries: Vec::new(),
+            max_rhat: 1.0,
+            min_ess_bulk: min_ess,
+            wall_seconds: 6.0,
+            map_wall_seconds: 0.6,
+            map_cpu_seconds: 0.5,
+            warmup_wall_seconds: 1.2,
+            warmup_cpu_seconds: 1.0,
+            sampling_wall_seconds: 9.0,
+            sampling_cpu_seconds: 8.0,
+            map_density_evaluations: 40,
+            map_gradient_evaluations: 60,
+            map_metric_evaluations: 10,
+            warmup_density_evaluations: 4 * 500,
+            warmup_gradient_evaluations: 4 * 700,
+            warmup_metric_evaluations: 4 * 300,
+            sampling_density_evaluations: 4 * 3000,
+            sampling_gradient_evaluations: 4 * 2000,
+            sampling_metric_evaluations: 4 * 1000,
+            divergences: 0,
+            map_log_density: 0.0,
+            log_evidence_laplace: 0.0,
+        }
+    }
+
+    #[test]
+    fn speed_is_counted_over_the_sampling_phase_and_over_the_whole_cost() {
+        let cost = RunCost::of(&run(850.0), true);
+        assert_eq!(cost.total_cpu_s, 0.5 + 1.0 + 8.0);
+        assert_eq!(cost.min_ess_per_s, 850.0 / 8.0);
+        assert_eq!(cost.min_ess_per_total_s, 850.0 / 9.5);
+        assert_eq!(cost.min_ess_per_wall_s, 850.0 / 6.0);
+        assert_eq!(cost.eval_kind, "gradient");
+        assert_eq!(cost.evaluations, 8000);
+        assert_eq!(cost.min_ess_per_eval, 850.0 / 8000.0);
+        // Fisher metrics of every phase count as gradients: 60 + 2800 + 8000 + (10 + 1200 + 4000).
+        assert_eq!(cost.all_evaluations, 16070);
+        assert_eq!(cost.min_ess_per_all_evals, 850.0 / 16070.0);
+        assert_eq!(cost.warmup_wall_s, 1.2);
+        assert_eq!(cost.sampling_wall_s, 9.0);
+    }
+
+    #[test]
+    fn random_walks_count_densities_and_the_maps_gradients_and_metrics() {
+        let cost = RunCost::of(&run(850.0), false);
+        assert_eq!(cost.eval_kind, "density");
+        assert_eq!(cost.evaluations, 12000);
+        assert_eq!(
+            cost.all_evaluations,
+            40 + 60 + 2000 + 12000 + (10 + 1200 + 4000)
+        );
+    }
+
+    #[test]
+    fn older_files_read_with_their_field_names() {
+        let cost: RunCost =
+            serde_json::from_str(r#"{"wall_s": 3.0, "map_s": 0.25, "warmup_s": 1.5}"#).unwrap();
+        assert_eq!(
+            (cost.wall_s, cost.map_wall_s, cost.warmup_wall_s),
+            (3.0, 0.25, 1.5)
+        );
+        assert_eq!(cost.total_cpu_s, 0.0);
+    }
+
+    #[test]
+    fn ratios_keep_two_significant_figures() {
+        assert_eq!(ratio_2sf(28.46), "28");
+        assert_eq!(ratio_2sf(7125.8), "7100");
+        assert_eq!(ratio_2sf(3.249), "3.2");
+        assert_eq!(ratio_2sf(0.5432), "0.54");
+        assert_eq!(ratio_2sf(9.96), "10");
+        assert_eq!(ratio_2sf(99.7), "100");
+        assert_eq!(ratio_2sf(20.0), "20");
+    }
+}
