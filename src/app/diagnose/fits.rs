@@ -187,6 +187,8 @@ pub fn column_name(problem: &Problem, channel: &str) -> String {
     match channel {
         "I" => map.current.clone(),
         "omega" => map.speed.clone(),
+        "q" => map.q.clone(),
+        "force" => map.force.clone(),
         other => other.to_string(),
     }
 }
