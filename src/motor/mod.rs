@@ -271,6 +271,37 @@ impl MotorModel {
         drive::simulate(self, drive, p, out)
     }
 
+    /// The torque balance of the mechanical equation at the model's values, from measured
+    /// quantities: c_g·u − d·ω + Σ term torques − J·ω̇, i.e. the torque the model misses at
+    /// that instant (the inverse-model residual; u is the current or controller output).
+    pub fn missing_torque(&self, input: f64, speed: f64, acceleration: f64, t: f64) -> f64 {
+        let p = self.parameter_values();
+        let mut c = base_coefficients(&p);
+        for (k, term) in self.terms.iter().enumerate() {
+            term.term
+                .adjust(&p[self.param_offsets[k]..self.param_offsets[k + 1]], &mut c);
+        }
+        let mut balance = Balance {
+            resistance: c.resistance,
+            torque_constant: c.torque_constant,
+            voltage: 0.0,
+            torque: 0.0,
+        };
+        for (k, term) in self.terms.iter().enumerate() {
+            let site = Site {
+                t,
+                segment_start: t,
+                current: input,
+                speed,
+                params: &p[self.param_offsets[k]..self.param_offsets[k + 1]],
+                states: &[],
+            };
+            term.term.contribute(&site, &mut balance);
+        }
+        balance.torque_constant * input - c.viscous_friction * speed + balance.torque
+            - acceleration / c.inverse_inertia
+    }
+
     /// The scales the default priors are drawn to, for a recording of the given length.
     pub fn magnitudes(&self, duration: f64) -> Magnitudes {
         let m = &self.nominal;

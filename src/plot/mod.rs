@@ -15,6 +15,7 @@ mod discrepancy;
 mod ess;
 mod frame;
 mod k_study;
+mod missing_torque;
 mod predictive;
 #[cfg(test)]
 mod tests;
@@ -28,6 +29,7 @@ pub use coefficients::{CoefficientMarginals, coefficient_marginals};
 pub use discrepancy::{DiscrepancyBand, discrepancy_band};
 pub use ess::{SamplerCurve, ess_per_second};
 pub use k_study::{KSeries, k_study};
+pub use missing_torque::{MissingTorqueCurve, MissingTorquePlot, missing_torque};
 pub use predictive::{ChannelPrediction, PredictivePlot, posterior_predictive};
 pub use traces::{TraceSeries, traces};
 

@@ -17,6 +17,7 @@ mod confirm;
 mod fits;
 mod report;
 mod screen;
+mod state;
 mod ties;
 
 use std::path::PathBuf;
@@ -30,6 +31,7 @@ pub use candidates::{
 pub use confirm::{Confirmation, importance_evidence};
 pub use fits::{FitSummary, Mismatch, Whiteness, ljung_box};
 pub use report::{Diagnosis, RankEntry, format_diagnosis};
+pub use state::StateFingerprint;
 
 use crate::bayes::ModelSettings;
 use crate::motor::Term;
@@ -71,7 +73,10 @@ pub struct DiagnoseOptions {
 fn candidate_names(problem: &Problem, given: Option<&[String]>) -> Result<Vec<String>, AppError> {
     let present = |name: &str| problem.model.terms.iter().any(|t| t.term.name() == name);
     let base = problem.model.base;
-    let applies = |name: &str| Term::named(name).is_some_and(|t| base.accepts(&t));
+    let several = problem.recordings.len() > 1;
+    let applies = |name: &str| {
+        Term::named(name).is_some_and(|t| base.accepts(&t) && !(several && t.record_time()))
+    };
     match given {
         Some(names) => {
             for n in names {
@@ -87,11 +92,18 @@ fn candidate_names(problem: &Problem, given: Option<&[String]>) -> Result<Vec<St
                     )));
                 }
                 if !applies(n) {
-                    return Err(AppError::Usage(format!(
-                        "--candidates: {n} acts on the electrical equation or the current \
-                         sensor, which a {} model does not have",
-                        base.name()
-                    )));
+                    let why = if several && Term::named(n).is_some_and(|t| t.record_time()) {
+                        "switches at a time within one record, and several records do not \
+                         share a clock"
+                            .to_string()
+                    } else {
+                        format!(
+                            "acts on the electrical equation or the current sensor, which a {} \
+                             model does not have",
+                            base.name()
+                        )
+                    };
+                    return Err(AppError::Usage(format!("--candidates: {n} {why}")));
                 }
             }
             Ok(names.to_vec())

@@ -17,6 +17,7 @@ use crate::motor::Term;
 use super::candidates::{CandidateFit, answer_params};
 use super::fits::{self, Convergence, FitSummary, Mismatch, SampledFit};
 use super::screen::collinear_pairs;
+use super::state::{StateFingerprint, fingerprint, reading};
 use super::ties::{separating_input, truth_problem};
 use super::{DiagnoseOptions, EVIDENCE_THRESHOLD};
 
@@ -40,11 +41,20 @@ pub struct RankEntry {
 pub struct Diagnosis {
     pub selected: String,
     pub selected_set: Vec<String>,
+    /// The selected model's MAP (calibrated parameters, physical values): what `--rank-only`
+    /// reports of the selected set's fit.
+    pub selected_params: BTreeMap<String, f64>,
     pub ranking: Vec<RankEntry>,
     pub ties: Vec<String>,
+    /// Pairs of candidates that both beat the model as given but that these records cannot
+    /// tell apart (Coulomb friction and a load torque on records that never reverse), with
+    /// the experiment in `tie_experiments` under `a/b`.
+    pub tied_pairs: Vec<[String; 2]>,
     /// For each tie, the input that would separate it from `selected`.
     pub tie_experiments: BTreeMap<String, String>,
     pub mismatch: Vec<Mismatch>,
+    /// Drive bases: the missing torque against speed, before and after the selected terms.
+    pub state: Vec<StateFingerprint>,
     pub fit_before: Option<FitSummary>,
     pub fit_after: Option<FitSummary>,
     pub notes: Vec<String>,
@@ -160,13 +170,42 @@ pub fn assemble(
         );
     }
 
+    let mut state = Vec::new();
+    let mut curves = Vec::new();
+    for (fit, label) in [(&none, "before"), (&selected_fit, "after")] {
+        if label == "after" && selected_set.is_empty() {
+            continue;
+        }
+        if let Some((f, curve)) = fingerprint(problem, fit, label)? {
+            notes.push(reading(&f));
+            state.push(f);
+            curves.push(curve);
+        }
+    }
+    let mut tied_pairs = Vec::new();
+    if state.first().is_some_and(|f| !f.reverses) {
+        let beats = |name: &str| {
+            ranking.iter().any(|f| {
+                f.added.first().is_some_and(|a| a == name)
+                    && f.score - none.score > EVIDENCE_THRESHOLD
+            })
+        };
+        let pair = ["coulomb_friction", "load_torque"];
+        if pair.iter().all(|n| beats(n)) {
+            tied_pairs.push(pair.map(String::from));
+            tie_experiments.insert(pair.join("/"), "reversal".into());
+        }
+    }
     let mut diagnosis = Diagnosis {
         selected,
         selected_set: selected_set.clone(),
+        selected_params: selected_fit.theta.clone(),
         ranking: ranking.iter().map(|f| entry(f, &none)).collect(),
         ties,
+        tied_pairs,
         tie_experiments,
         mismatch: Vec::new(),
+        state,
         fit_before: None,
         fit_after: None,
         notes,
@@ -183,6 +222,18 @@ pub fn assemble(
     };
     if !options.rank_only {
         sampled_fits(problem, options, k, &selected_fit, &mut diagnosis)?;
+    }
+    if let (Some(out), false) = (&options.out, curves.is_empty()) {
+        std::fs::create_dir_all(out)?;
+        let path = out.join("missing-torque.png");
+        let plot = crate::plot::MissingTorquePlot {
+            title: "the torque the model misses, against speed".into(),
+            speed_unit: problem.model.base.unit("rad/s").into(),
+            torque_unit: problem.model.base.unit("N·m").into(),
+            curves,
+        };
+        crate::plot::missing_torque(&path, &plot).map_err(|e| AppError::Output(e.to_string()))?;
+        diagnosis.outputs.push(path.display().to_string());
     }
     diagnosis.runtime_s = started.elapsed().as_secs_f64();
     if let Some(path) = &options.json {
@@ -382,6 +433,16 @@ pub fn format_diagnosis(d: &Diagnosis) -> String {
         );
     } else {
         let _ = writeln!(s, "the model lacks {}", d.selected_set.join(" + "));
+        if d.fit_after.is_none() {
+            let _ = writeln!(s, "its MAP:");
+            for (name, value) in &d.selected_params {
+                let unit = d
+                    .units
+                    .get(name)
+                    .map_or_else(|| unit_of(name), String::as_str);
+                let _ = writeln!(s, "  {name} = {value:.5e} {unit}");
+            }
+        }
         if let Some(after) = &d.fit_after {
             for (name, mean) in &after.params_mean {
                 let ci = after.params_95.get(name).copied().unwrap_or([f64::NAN; 2]);
@@ -418,6 +479,16 @@ pub fn format_diagnosis(d: &Diagnosis) -> String {
                 wa.p_value
             );
         }
+    }
+    for [a, b] in &d.tied_pairs {
+        let _ = writeln!(
+            s,
+            "{a} and {b} cannot be told apart on these records: add a {} record",
+            d.tie_experiments
+                .get(&format!("{a}/{b}"))
+                .map(String::as_str)
+                .unwrap_or("different")
+        );
     }
     for t in &d.ties {
         let _ = writeln!(

@@ -44,6 +44,7 @@ impl PhysicsTerm for LoadStep {
     const NAME: &'static str = "load_step";
     const EQUATION: &'static str = "J dω/dt += −T_s·H(t − t_s) (logistic of width `width`)";
     const MECHANICAL: bool = true;
+    const RECORD_TIME: bool = true;
     const PARAMS: &'static [TermParam] = &[
         TermParam {
             key: "T_s",

@@ -131,6 +131,10 @@ pub trait PhysicsTerm: Sized + Clone + std::fmt::Debug + PartialEq {
     /// Whether the term acts on the mechanical equation alone, so that it also applies to the
     /// drive bases, where the electrical equation and the current sensor are not modelled.
     const MECHANICAL: bool = false;
+    /// Whether a parameter is a time within the record (a switching time): such a term belongs
+    /// to one record, and is not a candidate for several records at once, whose clocks are
+    /// not one clock.
+    const RECORD_TIME: bool = false;
 
     /// The term with its settings (in the order of `SETTINGS`), or why they are invalid.
     fn with_settings(settings: &[f64]) -> Result<Self, String>;
@@ -270,6 +274,10 @@ macro_rules! terms {
 
             pub fn mechanical(&self) -> bool {
                 match self { $(Term::$variant(_) => <$variant as PhysicsTerm>::MECHANICAL),* }
+            }
+
+            pub fn record_time(&self) -> bool {
+                match self { $(Term::$variant(_) => <$variant as PhysicsTerm>::RECORD_TIME),* }
             }
 
             pub fn states(&self) -> &'static [TermState] {
