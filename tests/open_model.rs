@@ -370,7 +370,7 @@ fn each_prior_family_sampled_through_its_transform_has_the_priors_moments() {
 }
 
 #[test]
-fn all_twelve_terms_at_once_simulate_and_find_a_map() {
+fn all_terms_at_once_simulate_and_find_a_map() {
     let dir = scratch("twelve");
     let terms: Vec<ActiveTerm> = Term::NAMES
         .iter()

@@ -1,5 +1,5 @@
 //! Physics terms: each term's sensitivities (its extra state included) are the derivatives of
-//! the numerical solution, and all twelve together still simulate and fit.
+//! the numerical solution, and all of them together still simulate and fit.
 
 use motorcal::forward::ForwardModel;
 use motorcal::motor::{ActiveTerm, MotorModel, MotorParameters, Term, VoltageInput};
@@ -118,7 +118,7 @@ fn every_terms_sensitivities_match_finite_differences() {
 }
 
 #[test]
-fn all_twelve_terms_together_have_exact_sensitivities_simulate_and_fit() {
+fn all_terms_together_have_exact_sensitivities_simulate_and_fit() {
     let terms: Vec<ActiveTerm> = Term::NAMES.iter().map(|n| term(n)).collect();
     let model = MotorModel::with_terms(MotorParameters::default(), reversal(), terms).unwrap();
     let names = calibrated(&model);

@@ -38,10 +38,13 @@ pub struct Predictive {
     pub channels: Vec<ChannelPredictive>,
 }
 
-fn unit_of(channel: &str) -> &'static str {
+/// A channel's unit as the model's base reads it (m on a linear axis where a motor has rad).
+fn unit_of(channel: &str, base: crate::motor::Base) -> &'static str {
     match channel {
         "I" => "A",
-        "omega" => "rad/s",
+        "omega" => base.unit("rad/s"),
+        "q" => base.unit("rad"),
+        "force" => base.unit("N·m"),
         _ => "",
     }
 }
@@ -72,6 +75,7 @@ pub fn posterior_predictive(
         }
     }
     let times = posterior.forward(record).times().to_vec();
+    let base = posterior.forward(record).model().base;
     let m = times.len();
     let names: Vec<String> = posterior
         .forward(record)
@@ -119,7 +123,7 @@ pub fn posterior_predictive(
         let sigma = all.iter().map(|x| x[si].exp()).sum::<f64>() / all.len() as f64;
         channels.push(ChannelPredictive {
             name: name.clone(),
-            unit: unit_of(name).into(),
+            unit: unit_of(name, base).into(),
             measured: posterior.observed(record, c).to_vec(),
             model: model_at_mean[c * m..(c + 1) * m].to_vec(),
             mean,

@@ -77,6 +77,8 @@ pub enum BasisKind {
     /// Orthonormal Legendre polynomials on [0, T] (the paper's choice).
     #[default]
     Legendre,
+    /// Cubic B-splines on K − 2 equal spans, each scaled to unit mean square (long records).
+    Bspline,
 }
 
 impl BasisKind {
@@ -88,18 +90,21 @@ impl BasisKind {
     ) -> Result<Box<dyn super::DiscrepancyBasis>, String> {
         match self {
             BasisKind::Legendre => Ok(Box::new(super::Legendre::new(degree, t_end)?)),
+            BasisKind::Bspline => Ok(Box::new(super::BSpline::new(degree, t_end)?)),
         }
     }
 
     pub fn max_degree(&self) -> usize {
         match self {
             BasisKind::Legendre => super::basis::MAX_LEGENDRE_DEGREE,
+            BasisKind::Bspline => super::bspline::MAX_BSPLINE_DEGREE,
         }
     }
 
     pub fn name(&self) -> &'static str {
         match self {
             BasisKind::Legendre => "legendre",
+            BasisKind::Bspline => "bspline",
         }
     }
 }

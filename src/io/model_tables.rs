@@ -303,17 +303,29 @@ pub(super) fn parse_discrepancy(
 ) -> Result<DiscrepancyChoice, InputError> {
     let basis = match raw.basis.as_deref().unwrap_or("legendre") {
         "legendre" => Some(BasisKind::Legendre),
+        "bspline" => Some(BasisKind::Bspline),
         "none" => None,
         other => {
             return Err(error(
                 file,
                 locate,
                 "discrepancy.basis",
-                format!("unknown basis '{other}' (known: legendre, none)"),
+                format!("unknown basis '{other}' (known: legendre, bspline, none)"),
             ));
         }
     };
     let degree = raw.degree.unwrap_or(9);
+    if basis == Some(BasisKind::Bspline) && degree < crate::bayes::bspline::MIN_BSPLINE_DEGREE {
+        return Err(error(
+            file,
+            locate,
+            "discrepancy.degree",
+            format!(
+                "a B-spline basis needs degree ≥ {} (one cubic span), not {degree}",
+                crate::bayes::bspline::MIN_BSPLINE_DEGREE
+            ),
+        ));
+    }
     if let Some(kind) = basis
         && degree > kind.max_degree()
     {

@@ -8,7 +8,7 @@
 //! model without it by more than this. Under the null every one-parameter candidate's gain in
 //! log likelihood is ½χ²₁; with the ½·ln N penalty at N = 1002 observations, a false alarm
 //! among twelve candidates needs χ²₁ > 2·(3.45 + 2) = 10.9 for one of them, probability
-//! 12 × 0.1% ≈ 1%. A case that is fair to ask (a BIC margin ≥ 10 over `none`, i.e. a 5-nat
+//! 12 × 0.1% ≈ 1% (thirteen since `asymmetric_friction` joined: still about 1%). A case that is fair to ask (a BIC margin ≥ 10 over `none`, i.e. a 5-nat
 //! score lead) clears it with 3 nats to spare. Kass and Raftery call 2 nats (a Bayes factor of
 //! 7.4) positive evidence; the multiplicity of twelve candidates is why it is not 1.
 
@@ -60,7 +60,7 @@ pub struct DiagnoseOptions {
     pub data: Vec<PathBuf>,
     pub model: PathBuf,
     pub k: Option<usize>,
-    /// Term names to consider; `None`: all twelve not already in the model.
+    /// Term names to consider; `None`: every term the model lacks that applies to its base.
     pub candidates: Option<Vec<String>>,
     pub run: RunSettings,
     pub out: Option<PathBuf>,

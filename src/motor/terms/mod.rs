@@ -8,6 +8,7 @@
 //! macro below writes that enum and its dispatch once from the list of terms.
 
 mod armature_reaction;
+mod asymmetric_friction;
 mod back_emf_constant;
 mod coulomb_friction;
 mod current_offset;
@@ -21,6 +22,7 @@ mod viscous_friction;
 mod voltage_drop;
 
 pub use armature_reaction::ArmatureReaction;
+pub use asymmetric_friction::AsymmetricFriction;
 pub use back_emf_constant::BackEmfConstant;
 pub use coulomb_friction::CoulombFriction;
 pub use current_offset::CurrentOffset;
@@ -332,6 +334,7 @@ terms!(
     ArmatureReaction,
     CurrentOffset,
     SpeedGain,
+    AsymmetricFriction,
 );
 
 impl Term {
