@@ -64,6 +64,11 @@ impl MapEstimate {
 pub struct MapSettings {
     pub max_iterations: u64,
     pub gradient_tolerance: f64,
+    /// Stop the Gauss–Newton polish once its predicted gain is down at the log density's
+    /// rounding and no longer falls quadratically. Off by default: on a short record the
+    /// remaining steps cost microseconds, and the pinned runs start from the MAP the full
+    /// polish returns; on 20 000 samples each step's line search can cost 30 solves.
+    pub stop_at_rounding: bool,
 }
 
 impl Default for MapSettings {
@@ -71,6 +76,7 @@ impl Default for MapSettings {
         Self {
             max_iterations: 2000,
             gradient_tolerance: 1e-7,
+            stop_at_rounding: false,
         }
     }
 }
@@ -227,7 +233,7 @@ pub fn find_map<P: FisherMetric>(
         // gain ½·decrement² is down at that level and no longer falls quadratically, further
         // steps only chase rounding (each with a line search of up to 30 solves).
         let at_rounding = newton_decrement * newton_decrement < 1e-12 * log_density.abs().max(1.0);
-        if at_rounding && newton_decrement > 0.1 * previous_decrement {
+        if settings.stop_at_rounding && at_rounding && newton_decrement > 0.1 * previous_decrement {
             break;
         }
         let mut scale = 1.0;

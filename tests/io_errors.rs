@@ -406,8 +406,25 @@ fn model_files_round_trip_exactly() {
         current: "I_A".into(),
         speed: "w_rad_s".into(),
         voltage: "U".into(),
+        ..ChannelMap::default()
     };
     let path = dir.join("models/m.toml");
+    write_model_file(&path, &model).unwrap();
+    assert_eq!(read_model_file(&path).unwrap(), model);
+    // A drive base with its [drive] table and the channels only it uses.
+    model.schema = 2;
+    model.base = motorcal::motor::Base::PositionLoop;
+    model.drive = motorcal::motor::DriveSettings {
+        input_limit: Some(10.0),
+        position_gain: 160.18,
+        velocity_gain: 243.45,
+        delay_samples: 1,
+        substeps: 2,
+    };
+    model.channels.q = "qm_m".into();
+    model.channels.q_ref = "qg_m".into();
+    model.channels.force = "force_N".into();
+    model.channels.disturbance = "pulses_raw".into();
     write_model_file(&path, &model).unwrap();
     assert_eq!(read_model_file(&path).unwrap(), model);
     std::fs::remove_dir_all(&dir).unwrap();

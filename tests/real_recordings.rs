@@ -337,3 +337,25 @@ fn the_whole_emps_record_names_coulomb_friction_and_the_offset() {
     );
     assert!(after.rmse["force_N"] < 4.0 && d.fit_before.as_ref().unwrap().rmse["force_N"] > 9.0);
 }
+
+#[test]
+#[ignore = "two whole HSM150 records: about 1.5 min on 2 cores; run before resolving"]
+fn one_hsm150_record_of_each_direction_names_coulomb_friction_and_the_documented_inertia() {
+    let Some(dir) = real_dir() else { return };
+    let data = ["idf_pos_0.06_1", "idf_neg_0.04_1"]
+        .iter()
+        .map(|name| dir.join(format!("hsm150/{name}.csv")))
+        .collect();
+    let mut o = options(data, example("hsm150"), &[]);
+    o.candidates = None;
+    let d = diagnose(&o).unwrap();
+    println!("{}", motorcal::app::diagnose::format_diagnosis(&d));
+    assert!(
+        d.selected_set.iter().any(|s| s == "coulomb_friction"),
+        "{:?}",
+        d.selected_set
+    );
+    let (j, damping) = (d.selected_params["J"], d.selected_params["d"]);
+    assert!((j / 1.2e-4 - 1.0).abs() < 0.25, "J {j}");
+    assert!((damping / 7.03e-5 - 1.0).abs() < 0.25, "d {damping}");
+}

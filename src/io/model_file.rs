@@ -559,7 +559,7 @@ mod tests {
                 "unknown basis",
             ),
             (
-                "schema = 2\nbase = \"current_driven\"\n",
+                "schema = 2\nbase = \"flux_driven\"\n",
                 2,
                 "base",
                 "unknown base model",

@@ -232,7 +232,11 @@ fn best_map(
     let mut best: Option<MapEstimate> = None;
     let mut last_error = None;
     for s in starts {
-        match find_map(posterior, &s, &MapSettings::default()) {
+        let settings = MapSettings {
+            stop_at_rounding: long_record,
+            ..MapSettings::default()
+        };
+        match find_map(posterior, &s, &settings) {
             Ok(map) => {
                 if best
                     .as_ref()

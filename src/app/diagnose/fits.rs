@@ -14,7 +14,8 @@ use crate::app::problem::Problem;
 use crate::bayes::{CalibrationPosterior, ModelSettings};
 use crate::density::LogDensity;
 use crate::diagnostics::autocovariance;
-use crate::pipeline::{RunOutput, RunSettings, finish_run, map_estimate, run_sampler};
+use crate::optimize::{MapSettings, find_map};
+use crate::pipeline::{RunOutput, RunSettings, finish_run, run_sampler};
 use crate::sampler::driver::chain_rng;
 use crate::sampler::{ChainOutput, DrawRecord};
 
@@ -137,7 +138,12 @@ pub fn sample(
 fn laplace_run(posterior: &mut CalibrationPosterior, seed: u64) -> Result<RunOutput, AppError> {
     use rand_distr::{Distribution, StandardNormal};
     let started = std::time::Instant::now();
-    let map = map_estimate(posterior)?;
+    let start = posterior.initial_point()?;
+    let settings = MapSettings {
+        stop_at_rounding: true,
+        ..MapSettings::default()
+    };
+    let map = find_map(posterior, &start, &settings)?;
     let (l_inv_t, _) = map.whitening().map_err(AppError::Numerical)?;
     let mut rng = chain_rng(seed ^ 0x1a91_ace0, 0);
     let d = map.x.len();
