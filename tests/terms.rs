@@ -123,7 +123,11 @@ fn all_terms_together_have_exact_sensitivities_simulate_and_fit() {
     let terms: Vec<ActiveTerm> = Term::NAMES.iter().map(|n| term(n)).collect();
     let model = MotorModel::with_terms(MotorParameters::default(), reversal(), terms).unwrap();
     let names = calibrated(&model);
-    assert_eq!(names.len(), 15, "R and fourteen term parameters (load_step has two)");
+    assert_eq!(
+        names.len(),
+        15,
+        "R and fourteen term parameters (load_step has two)"
+    );
     assert_eq!(model.n_states(), 3, "I, ω and the heating's energy");
     assert_sensitivities_match_finite_differences(model, &names);
 }

@@ -153,7 +153,7 @@ mod tests {
             }
         }
         let times: Vec<f64> = (0..10).map(|i| i as f64 * 0.01).collect();
-        let mut out = vec![0.0; 10];
+        let mut out = [0.0; 10];
         solve_sampled(&Integrator, &[1.0], &times, 1, |k, y| {
             out[k] = y[0];
             -5.0 * y[0]
