@@ -42,18 +42,6 @@ pub struct RecordPrediction {
     pub channels: Vec<(String, Vec<f64>, Vec<f64>)>,
 }
 
-/// The unit of a model channel for a base, for reports.
-pub fn channel_unit(problem: &Problem, channel: &str) -> &'static str {
-    let base = problem.model.base;
-    match channel {
-        "I" => "A",
-        "omega" => base.unit("rad/s"),
-        "q" => base.unit("rad"),
-        "force" => base.unit("N·m"),
-        _ => "",
-    }
-}
-
 /// Simulates every record at the model file's values.
 pub fn predict_records(problem: &Problem) -> Result<Vec<RecordPrediction>, AppError> {
     let forwards = problem.forward_models(SolverSettings::default())?;
@@ -104,7 +92,7 @@ pub fn residuals(problem: &Problem, predictions: &[RecordPrediction]) -> Vec<Cha
                 ChannelResidual {
                     record: p.source.clone(),
                     channel: name.clone(),
-                    unit: channel_unit(problem, name).to_string(),
+                    unit: problem.model.base.channel_unit(name).to_string(),
                     samples: measured.len(),
                     residual_rms,
                     measured_rms,

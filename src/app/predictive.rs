@@ -38,17 +38,6 @@ pub struct Predictive {
     pub channels: Vec<ChannelPredictive>,
 }
 
-/// A channel's unit as the model's base reads it (m on a linear axis where a motor has rad).
-fn unit_of(channel: &str, base: crate::motor::Base) -> &'static str {
-    match channel {
-        "I" => "A",
-        "omega" => base.unit("rad/s"),
-        "q" => base.unit("rad"),
-        "force" => base.unit("N·m"),
-        _ => "",
-    }
-}
-
 fn quantile(sorted: &[f64], q: f64) -> f64 {
     let h = (sorted.len() - 1) as f64 * q;
     let (lo, hi) = (h.floor() as usize, h.ceil() as usize);
@@ -123,7 +112,7 @@ pub fn posterior_predictive(
         let sigma = all.iter().map(|x| x[si].exp()).sum::<f64>() / all.len() as f64;
         channels.push(ChannelPredictive {
             name: name.clone(),
-            unit: unit_of(name, base).into(),
+            unit: base.channel_unit(name).into(),
             measured: posterior.observed(record, c).to_vec(),
             model: model_at_mean[c * m..(c + 1) * m].to_vec(),
             mean,

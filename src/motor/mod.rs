@@ -60,6 +60,17 @@ impl Base {
         }
     }
 
+    /// The unit of one of the base's channels.
+    pub fn channel_unit(&self, channel: &str) -> &'static str {
+        match channel {
+            "I" => "A",
+            "omega" => self.unit("rad/s"),
+            "q" => self.unit("rad"),
+            "force" => self.unit("N·m"),
+            _ => "",
+        }
+    }
+
     /// Whether a drive closes the electrical loop (the recorded input drives the mechanics).
     pub fn is_drive(&self) -> bool {
         *self != Base::VoltageDriven
