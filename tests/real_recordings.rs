@@ -9,7 +9,7 @@ use std::process::Command;
 
 use nalgebra::DMatrix;
 
-use motorcal::app::diagnose::{DiagnoseOptions, diagnose};
+use motorcal::app::diagnose::{DiagnoseOptions, diagnose, records_reverse};
 use motorcal::app::predict::{PredictOptions, predict};
 use motorcal::app::problem::Problem;
 use motorcal::app::run::{RunSettings, SamplerKind};
@@ -358,4 +358,18 @@ fn one_hsm150_record_of_each_direction_names_coulomb_friction_and_the_documented
     let (j, damping) = (d.selected_params["J"], d.selected_params["d"]);
     assert!((j / 1.2e-4 - 1.0).abs() < 0.25, "J {j}");
     assert!((damping / 7.03e-5 - 1.0).abs() < 0.25, "d {damping}");
+}
+
+#[test]
+fn records_in_one_direction_are_told_from_records_that_reverse() {
+    let Some(dir) = real_dir() else { return };
+    let emps = window(&dir.join("emps/emps_estimation.csv"), 4000, "emps-4s-b.csv");
+    let emps = Problem::from_files(&[emps], &example("emps")).unwrap();
+    assert!(records_reverse(&emps).unwrap());
+    let pos = dir.join("hsm150/idf_pos_0.06_1.csv");
+    let neg = dir.join("hsm150/idf_neg_0.04_1.csv");
+    let one = Problem::from_files(std::slice::from_ref(&pos), &example("hsm150")).unwrap();
+    assert!(!records_reverse(&one).unwrap());
+    let both = Problem::from_files(&[pos, neg], &example("hsm150")).unwrap();
+    assert!(records_reverse(&both).unwrap());
 }

@@ -31,7 +31,7 @@ pub use candidates::{
 pub use confirm::{Confirmation, importance_evidence};
 pub use fits::{FitSummary, Mismatch, Whiteness, ljung_box};
 pub use report::{Diagnosis, RankEntry, format_diagnosis};
-pub use state::StateFingerprint;
+pub use state::{StateFingerprint, records_reverse};
 
 use crate::bayes::ModelSettings;
 use crate::motor::Term;
@@ -167,10 +167,23 @@ pub fn forward_selection(
         return Ok((Vec::new(), none));
     }
     let mut current = best.clone();
+    // On records that never reverse, Coulomb friction and a load torque are one torque (they
+    // differ only in the first milliseconds of a start-up): both at once is a model whose two
+    // levels trade freely, and its MAP a degenerate one (T_c and T_0 of ten times their size
+    // and opposite signs, measured on HSM150), so the second of the pair is not offered.
+    let one_direction = !state::records_reverse(problem)?;
+    let same_torque = |a: &str, b: &str| {
+        one_direction
+            && matches!(
+                (a, b),
+                ("coulomb_friction", "load_torque") | ("load_torque", "coulomb_friction")
+            )
+    };
     while current.added.len() < MAX_TERMS {
         let sets: Vec<Vec<String>> = candidates
             .iter()
             .filter(|name| !current.added.contains(name))
+            .filter(|name| !current.added.iter().any(|a| same_torque(a, name)))
             .map(|name| {
                 let mut added = current.added.clone();
                 added.push(name.clone());

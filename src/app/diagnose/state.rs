@@ -113,6 +113,30 @@ fn samples(problem: &Problem) -> Result<Vec<(f64, f64)>, AppError> {
     Ok(out)
 }
 
+/// Whether a drive base's records hold motion in both directions (measured speed beyond
+/// [`MOVING_SHARE`] of its top on both sides of zero); `true` for the voltage-driven motor, whose
+/// candidates this does not concern.
+pub fn records_reverse(problem: &Problem) -> Result<bool, AppError> {
+    let mut speeds = Vec::new();
+    for recording in &problem.recordings {
+        let times = &recording.time;
+        let dt = (recording.last_time() - times[0]) / (times.len().max(2) - 1) as f64;
+        let width = ((SMOOTHING_S / dt).round() as usize).max(1) | 1;
+        match problem.model.base {
+            Base::CurrentDriven => speeds.extend(recording.channel("omega").unwrap_or(&[])),
+            Base::PositionLoop => {
+                if let Some(q) = recording.channel("q") {
+                    speeds.extend(derivative(&smooth(q, width), times));
+                }
+            }
+            Base::VoltageDriven => return Ok(true),
+        }
+    }
+    let top = speeds.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    let moving = |sign: f64| speeds.iter().any(|v| v * sign > MOVING_SHARE * top);
+    Ok(moving(1.0) && moving(-1.0))
+}
+
 /// The fingerprint and the binned curve of `fit`'s model (`none` for the model as given).
 pub fn fingerprint(
     problem: &Problem,
