@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 use super::atomic::{with_path, write_atomically};
 use super::error::{InputError, read_text};
 use super::table::{self, Line};
-use crate::motor::{Base, DriveSettings, MOTOR_CHANNELS, SampledDrive, VoltageInput};
+use crate::motor::{Base, DriveSettings, SampledDrive, VoltageInput};
 
 /// Which CSV column holds what the model needs. Keys in a model file's `[channels]` table.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -47,6 +47,24 @@ impl Default for ChannelMap {
             q_ref: "q_ref".into(),
             force: "force".into(),
             disturbance: "disturbance".into(),
+        }
+    }
+}
+
+impl ChannelMap {
+    /// The column that holds a model channel or input (`I`, `omega`, `U`, `q`, `q_ref`,
+    /// `force`, `disturbance`; `t` for time); an unknown name is its own column.
+    pub fn column<'a>(&'a self, model_name: &'a str) -> &'a str {
+        match model_name {
+            "t" => &self.t,
+            "I" => &self.current,
+            "omega" => &self.speed,
+            "U" => &self.voltage,
+            "q" => &self.q,
+            "q_ref" => &self.q_ref,
+            "force" => &self.force,
+            "disturbance" => &self.disturbance,
+            other => other,
         }
     }
 }
@@ -159,30 +177,20 @@ struct Roles {
 }
 
 fn roles(map: &ChannelMap, base: Base) -> Roles {
-    match base {
-        Base::VoltageDriven => Roles {
-            outputs: vec![
-                (MOTOR_CHANNELS[0], map.current.clone()),
-                (MOTOR_CHANNELS[1], map.speed.clone()),
-            ],
-            inputs: vec![(
-                "U",
-                map.voltage.clone(),
-                map.voltage != ChannelMap::default().voltage,
-            )],
-        },
-        Base::CurrentDriven => Roles {
-            outputs: vec![("omega", map.speed.clone())],
-            inputs: vec![("I", map.current.clone(), true)],
-        },
-        Base::PositionLoop => Roles {
-            outputs: vec![("q", map.q.clone()), ("force", map.force.clone())],
+    let input = |name: &'static str, required: bool| (name, map.column(name).to_string(), required);
+    Roles {
+        outputs: base
+            .channels()
+            .iter()
+            .map(|&c| (c, map.column(c).to_string()))
+            .collect(),
+        inputs: match base {
+            // A voltage column the user named must exist; the default `U` may be absent.
+            Base::VoltageDriven => vec![input("U", map.voltage != ChannelMap::default().voltage)],
+            Base::CurrentDriven => vec![input("I", true)],
             // The disturbance is absent from ordinary records of a rig whose validation record
             // has it: 0 then, not an error.
-            inputs: vec![
-                ("q_ref", map.q_ref.clone(), true),
-                ("disturbance", map.disturbance.clone(), false),
-            ],
+            Base::PositionLoop => vec![input("q_ref", true), input("disturbance", false)],
         },
     }
 }

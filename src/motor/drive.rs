@@ -17,7 +17,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::terms::{Balance, Site};
-use super::{Base, MotorModel, MotorParam, Scalar, base_coefficients};
+use super::{Base, MotorModel, MotorParam, Scalar};
 use crate::ode::{HeldInputSystem, OdeError, SolverStats, solve_sampled};
 
 /// The `[drive]` table of a model file: how the drive turns its input into torque.
@@ -161,13 +161,7 @@ pub(super) fn simulate<D: Scalar>(
     p: &[D],
     out: &mut [D],
 ) -> Result<SolverStats, OdeError> {
-    let mut coefficients = base_coefficients(p);
-    for (k, t) in model.terms.iter().enumerate() {
-        t.term.adjust(
-            &p[model.param_offsets[k]..model.param_offsets[k + 1]],
-            &mut coefficients,
-        );
-    }
+    let coefficients = model.coefficients(p);
     let system = Mechanics {
         model,
         p,

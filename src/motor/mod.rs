@@ -283,34 +283,40 @@ impl MotorModel {
     }
 
     /// The torque balance of the mechanical equation at the model's values, from measured
-    /// quantities: c_g·u − d·ω + Σ term torques − J·ω̇, i.e. the torque the model misses at
-    /// that instant (the inverse-model residual; u is the current or controller output).
-    pub fn missing_torque(&self, input: f64, speed: f64, acceleration: f64, t: f64) -> f64 {
+    /// series: c_g·u − d·ω + Σ term torques − J·ω̇ at every sample, i.e. the torque the model
+    /// misses there (the inverse-model residual; u is the current or controller output).
+    pub fn missing_torque(
+        &self,
+        times: &[f64],
+        input: &[f64],
+        speed: &[f64],
+        acceleration: &[f64],
+    ) -> Vec<f64> {
         let p = self.parameter_values();
-        let mut c = base_coefficients(&p);
-        for (k, term) in self.terms.iter().enumerate() {
-            term.term
-                .adjust(&p[self.param_offsets[k]..self.param_offsets[k + 1]], &mut c);
-        }
-        let mut balance = Balance {
-            resistance: c.resistance,
-            torque_constant: c.torque_constant,
-            voltage: 0.0,
-            torque: 0.0,
-        };
-        for (k, term) in self.terms.iter().enumerate() {
-            let site = Site {
-                t,
-                segment_start: t,
-                current: input,
-                speed,
-                params: &p[self.param_offsets[k]..self.param_offsets[k + 1]],
-                states: &[],
-            };
-            term.term.contribute(&site, &mut balance);
-        }
-        balance.torque_constant * input - c.viscous_friction * speed + balance.torque
-            - acceleration / c.inverse_inertia
+        let c = self.coefficients(&p);
+        (0..times.len())
+            .map(|i| {
+                let mut balance = Balance {
+                    resistance: c.resistance,
+                    torque_constant: c.torque_constant,
+                    voltage: 0.0,
+                    torque: 0.0,
+                };
+                for (k, term) in self.terms.iter().enumerate() {
+                    let site = Site {
+                        t: times[i],
+                        segment_start: times[i],
+                        current: input[i],
+                        speed: speed[i],
+                        params: &p[self.param_offsets[k]..self.param_offsets[k + 1]],
+                        states: &[],
+                    };
+                    term.term.contribute(&site, &mut balance);
+                }
+                balance.torque_constant * input[i] - c.viscous_friction * speed[i] + balance.torque
+                    - acceleration[i] / c.inverse_inertia
+            })
+            .collect()
     }
 
     /// The scales the default priors are drawn to, for a recording of the given length.
@@ -463,6 +469,17 @@ impl MotorModel {
         p: &'a [D],
         segments: &'a Segments,
     ) -> MotorSystem<'a, D> {
+        MotorSystem {
+            model: self,
+            p,
+            coefficients: self.coefficients(p),
+            segments,
+        }
+    }
+
+    /// The constants the right-hand side uses at a parameter vector, after the terms that
+    /// rescale one (torque constant, extra viscous friction) have acted: once per solve.
+    pub fn coefficients<D: Scalar>(&self, p: &[D]) -> Coefficients<D> {
         let mut coefficients = base_coefficients(p);
         for (k, t) in self.terms.iter().enumerate() {
             t.term.adjust(
@@ -470,12 +487,7 @@ impl MotorModel {
                 &mut coefficients,
             );
         }
-        MotorSystem {
-            model: self,
-            p,
-            coefficients,
-            segments,
-        }
+        coefficients
     }
 
     /// The breakpoints and the input held on each interval between them.
@@ -537,7 +549,7 @@ fn base_spec(p: MotorParam, nominal: f64, m: &Magnitudes) -> ParameterSpec {
     }
 }
 
-pub(crate) fn base_coefficients<D: Scalar>(p: &[D]) -> Coefficients<D> {
+fn base_coefficients<D: Scalar>(p: &[D]) -> Coefficients<D> {
     use MotorParam::*;
     Coefficients {
         resistance: p[Resistance as usize],

@@ -82,7 +82,7 @@ pub fn coefficient_marginals(
                 PanelSpec {
                     x: xa.clone(),
                     y: axes[i].clone().unwrap_or_else(|| Axis::fallback(false)),
-                    x_desc: "coefficient index j (Legendre degree)",
+                    x_desc: "coefficient index j",
                     y_desc: &with_unit(&format!("a_j of δ {}", ch.name), &ch.unit),
                     x_ticks: last,
                     x_area: if last { X_AREA } else { 0 },

@@ -189,14 +189,7 @@ pub const LAPLACE: &str = "laplace (draws from the Gaussian at the MAP)";
 
 /// The recording's own name of a model channel.
 pub fn column_name(problem: &Problem, channel: &str) -> String {
-    let map = &problem.model.channels;
-    match channel {
-        "I" => map.current.clone(),
-        "omega" => map.speed.clone(),
-        "q" => map.q.clone(),
-        "force" => map.force.clone(),
-        other => other.to_string(),
-    }
+    problem.model.channels.column(channel).to_string()
 }
 
 fn key(problem: &Problem, record: usize, channel: &str) -> String {

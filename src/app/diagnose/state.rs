@@ -11,6 +11,7 @@ use serde::Serialize;
 
 use crate::app::AppError;
 use crate::app::problem::Problem;
+use crate::io::Recording;
 use crate::motor::Base;
 use crate::plot::MissingTorqueCurve;
 
@@ -73,42 +74,46 @@ fn derivative(values: &[f64], times: &[f64]) -> Vec<f64> {
         .collect()
 }
 
+/// A record's speed and drive input as measured, smoothed over [`SMOOTHING_S`]: ω and the
+/// current (`current_driven`), or the derivative of q and the force over c_g
+/// (`position_loop`); `None` for the voltage-driven motor.
+fn measured(problem: &Problem, recording: &Recording) -> Result<Option<[Vec<f64>; 2]>, AppError> {
+    let times = &recording.time;
+    let dt = (recording.last_time() - times[0]) / (times.len().max(2) - 1) as f64;
+    let width = ((SMOOTHING_S / dt).round() as usize).max(1) | 1;
+    let missing = |what: &str| AppError::Usage(format!("{}: no {what}", recording.source));
+    let channel = |name: &str| recording.channel(name).ok_or_else(|| missing(name));
+    Ok(Some(match problem.model.base {
+        Base::CurrentDriven => {
+            let current = recording
+                .input("I")
+                .ok_or_else(|| missing("current input"))?;
+            [smooth(channel("omega")?, width), smooth(current, width)]
+        }
+        Base::PositionLoop => {
+            let gain = problem.model.motor.torque_constant;
+            let controller: Vec<f64> = channel("force")?.iter().map(|f| f / gain).collect();
+            let q = smooth(channel("q")?, width);
+            [
+                smooth(&derivative(&q, times), width),
+                smooth(&controller, width),
+            ]
+        }
+        Base::VoltageDriven => return Ok(None),
+    }))
+}
+
 /// (speed, missing torque) at every sample of every record, for the model of `problem`.
 fn samples(problem: &Problem) -> Result<Vec<(f64, f64)>, AppError> {
     let mut out = Vec::new();
     for recording in &problem.recordings {
+        let Some([speed, input]) = measured(problem, recording)? else {
+            continue;
+        };
+        let acceleration = derivative(&speed, &recording.time);
         let model = problem.model_for(recording)?;
-        let times = &recording.time;
-        let dt = (recording.last_time() - times[0]) / (times.len().max(2) - 1) as f64;
-        let width = ((SMOOTHING_S / dt).round() as usize).max(1) | 1;
-        let channel = |name: &str| {
-            recording.channel(name).ok_or_else(|| {
-                AppError::Usage(format!("{}: no channel '{name}'", recording.source))
-            })
-        };
-        let (speed, input) = match problem.model.base {
-            Base::CurrentDriven => {
-                let current = recording.input("I").ok_or_else(|| {
-                    AppError::Usage(format!("{}: no current input", recording.source))
-                })?;
-                (smooth(channel("omega")?, width), smooth(current, width))
-            }
-            Base::PositionLoop => {
-                let gain = model.nominal.torque_constant;
-                let controller: Vec<f64> = channel("force")?.iter().map(|f| f / gain).collect();
-                let q = smooth(channel("q")?, width);
-                (
-                    smooth(&derivative(&q, times), width),
-                    smooth(&controller, width),
-                )
-            }
-            Base::VoltageDriven => return Ok(Vec::new()),
-        };
-        let acceleration = derivative(&speed, times);
-        for i in 0..times.len() {
-            let missing = model.missing_torque(input[i], speed[i], acceleration[i], times[i]);
-            out.push((speed[i], missing));
-        }
+        let missing = model.missing_torque(&recording.time, &input, &speed, &acceleration);
+        out.extend(speed.into_iter().zip(missing));
     }
     Ok(out)
 }
@@ -119,17 +124,9 @@ fn samples(problem: &Problem) -> Result<Vec<(f64, f64)>, AppError> {
 pub fn records_reverse(problem: &Problem) -> Result<bool, AppError> {
     let mut speeds = Vec::new();
     for recording in &problem.recordings {
-        let times = &recording.time;
-        let dt = (recording.last_time() - times[0]) / (times.len().max(2) - 1) as f64;
-        let width = ((SMOOTHING_S / dt).round() as usize).max(1) | 1;
-        match problem.model.base {
-            Base::CurrentDriven => speeds.extend(recording.channel("omega").unwrap_or(&[])),
-            Base::PositionLoop => {
-                if let Some(q) = recording.channel("q") {
-                    speeds.extend(derivative(&smooth(q, width), times));
-                }
-            }
-            Base::VoltageDriven => return Ok(true),
+        match measured(problem, recording)? {
+            Some([speed, _]) => speeds.extend(speed),
+            None => return Ok(true),
         }
     }
     let top = speeds.iter().fold(0.0f64, |a, v| a.max(v.abs()));

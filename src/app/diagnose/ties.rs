@@ -41,15 +41,7 @@ pub fn separating_input(
             crate::motor::VoltageInput::Constant => None,
         };
         let synthetic = recording_from(&data, &format!("simulated {input:?} input"), values);
-        let experiment = Problem {
-            label: synthetic.source.clone(),
-            recordings: vec![synthetic],
-            model: base.model.clone(),
-            reference: None,
-        };
-        let a = fit_candidate(&experiment, &selected.added)?;
-        let b = fit_candidate(&experiment, &[other.to_string()])?;
-        if a.score - b.score > threshold {
+        if separates(base, synthetic, selected, other, threshold)? {
             return Ok(Some(input));
         }
     }
@@ -104,6 +96,18 @@ fn reversed_record(
             *v = g + noise.sample(&mut rng);
         }
     }
+    Ok(separates(base, recording, selected, other, threshold)?.then_some(InputProfile::Reversal))
+}
+
+/// Whether the selected terms beat `other` by more than `threshold` on a simulated recording,
+/// both refitted to it from the user's model.
+fn separates(
+    base: &Problem,
+    recording: crate::io::Recording,
+    selected: &CandidateFit,
+    other: &str,
+    threshold: f64,
+) -> Result<bool, AppError> {
     let experiment = Problem {
         label: recording.source.clone(),
         recordings: vec![recording],
@@ -112,7 +116,7 @@ fn reversed_record(
     };
     let a = fit_candidate(&experiment, &selected.added)?;
     let b = fit_candidate(&experiment, &[other.to_string()])?;
-    Ok((a.score - b.score > threshold).then_some(InputProfile::Reversal))
+    Ok(a.score - b.score > threshold)
 }
 
 /// The user's model with the selected terms at their estimates and the calibrated base
