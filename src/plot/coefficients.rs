@@ -59,7 +59,7 @@ pub fn coefficient_marginals(
         let n_max = channels.iter().map(|c| c.mean.len()).max().unwrap_or(1);
         let xa = linear_axis([-0.5, n_max as f64 - 0.5], 0.0, 0.0, false, 10)
             .unwrap_or_else(|| Axis::fallback(false));
-        let axes: Vec<Option<Axis>> = channels
+        let axes: Vec<(Option<Axis>, bool, String)> = channels
             .iter()
             .map(|c| {
                 let vals = c
@@ -70,25 +70,15 @@ pub fn coefficient_marginals(
                     .chain(c.reference.iter().flatten())
                     .chain(&[0.0])
                     .copied();
-                linear_axis(vals, 0.06, 0.0, false, y_ticks_for(row_h - 20))
+                (
+                    linear_axis(vals, 0.06, 0.0, false, y_ticks_for(row_h - 20)),
+                    false,
+                    with_unit(&format!("a_j of δ {}", c.name), &c.unit),
+                )
             })
             .collect();
-        let y_area = y_label_area(root, axes.iter().flatten());
-        let rows = stack_rows(&body, channels.len(), X_AREA);
-        for (i, (ch, area)) in channels.iter().zip(&rows).enumerate() {
-            let last = i + 1 == channels.len();
-            let mut p = Panel::new(
-                area,
-                PanelSpec {
-                    x: xa.clone(),
-                    y: axes[i].clone().unwrap_or_else(|| Axis::fallback(false)),
-                    x_desc: "coefficient index j",
-                    y_desc: &with_unit(&format!("a_j of δ {}", ch.name), &ch.unit),
-                    x_ticks: last,
-                    x_area: if last { X_AREA } else { 0 },
-                    y_area,
-                },
-            )?;
+        stacked_panels(root, &body, &xa, "coefficient index j", &axes, |i, p| {
+            let ch = &channels[i];
             p.hline(0.0, BLACK.mix(0.5).stroke_width(1), false)?;
             let js: Vec<f64> = (0..ch.mean.len()).map(|j| j as f64).collect();
             for (j, (&lo, &hi)) in ch.lower.iter().zip(&ch.upper).enumerate() {
@@ -119,8 +109,7 @@ pub fn coefficient_marginals(
                     },
                 );
             }
-            p.finish()?;
-        }
-        Ok(())
+            Ok(())
+        })
     })
 }

@@ -69,7 +69,7 @@ pub fn discrepancy_band(
         let body = titled(root, title)?;
         let xa = linear_axis(times.iter().copied(), 0.0, 0.0, false, 8)
             .unwrap_or_else(|| Axis::fallback(false));
-        let axes: Vec<Option<Axis>> = channels
+        let axes: Vec<(Option<Axis>, bool, String)> = channels
             .iter()
             .map(|c| {
                 let vals = c
@@ -80,28 +80,15 @@ pub fn discrepancy_band(
                     .chain(c.reference.iter().flatten())
                     .chain(&[0.0])
                     .copied();
-                linear_axis(vals, 0.06, 0.0, false, y_ticks_for(row_h - 20))
+                (
+                    linear_axis(vals, 0.06, 0.0, false, y_ticks_for(row_h - 20)),
+                    false,
+                    with_unit(&format!("δ {}", c.name), &c.unit),
+                )
             })
             .collect();
-        let y_area = y_label_area(root, axes.iter().flatten());
-        let rows = stack_rows(&body, channels.len(), X_AREA);
-        for (i, (ch, area)) in channels.iter().zip(&rows).enumerate() {
-            let last = i + 1 == channels.len();
-            let mut p = Panel::new(
-                area,
-                PanelSpec {
-                    x: xa.clone(),
-                    y: axes[i].clone().unwrap_or_else(|| Axis::fallback(false)),
-                    x_desc: "time [s]",
-                    y_desc: &with_unit(&format!("δ {}", ch.name), &ch.unit),
-                    x_ticks: last,
-                    x_area: if last { X_AREA } else { 0 },
-                    y_area,
-                },
-            )?;
-            if axes[i].is_none() {
-                p.note("no finite data")?;
-            }
+        stacked_panels(root, &body, &xa, "time [s]", &axes, |i, p| {
+            let ch = &channels[i];
             p.hline(0.0, BLACK.mix(0.5).stroke_width(1), false)?;
             p.band(times, &ch.lower, &ch.upper, C_BLUE.mix(0.22))?;
             if let Some(r) = &ch.reference {
@@ -127,8 +114,7 @@ pub fn discrepancy_band(
                     },
                 );
             }
-            p.finish()?;
-        }
-        Ok(())
+            Ok(())
+        })
     })
 }

@@ -78,7 +78,7 @@ pub fn k_study(path: &Path, title: &str, series: &[KSeries]) -> Result<(), PlotE
             12,
         )
         .unwrap_or_else(|| Axis::fallback(false));
-        let axes: Vec<Option<Axis>> = series
+        let axes: Vec<(Option<Axis>, bool, String)> = series
             .iter()
             .map(|s| {
                 let (lo_sd, hi_sd) = sd_band(s);
@@ -92,32 +92,16 @@ pub fn k_study(path: &Path, title: &str, series: &[KSeries]) -> Result<(), PlotE
                     .copied()
                     .chain(s.reference);
                 let target = y_ticks_for(row_h - 20);
-                if s.log_y {
+                let axis = if s.log_y {
                     log_axis(vals, 0.06, target)
                 } else {
                     linear_axis(vals, 0.06, 0.0, false, target)
-                }
+                };
+                (axis, s.log_y, with_unit(&s.name, &s.unit))
             })
             .collect();
-        let y_area = y_label_area(root, axes.iter().flatten());
-        let rows = stack_rows(&body, series.len(), X_AREA);
-        for (i, (s, area)) in series.iter().zip(&rows).enumerate() {
-            let last = i + 1 == series.len();
-            let mut p = Panel::new(
-                area,
-                PanelSpec {
-                    x: xa.clone(),
-                    y: axes[i].clone().unwrap_or_else(|| Axis::fallback(s.log_y)),
-                    x_desc: "K (discrepancy degree)",
-                    y_desc: &with_unit(&s.name, &s.unit),
-                    x_ticks: last,
-                    x_area: if last { X_AREA } else { 0 },
-                    y_area,
-                },
-            )?;
-            if axes[i].is_none() {
-                p.note("no finite data")?;
-            }
+        stacked_panels(root, &body, &xa, "K (discrepancy degree)", &axes, |i, p| {
+            let s = &series[i];
             let mut order: Vec<usize> = (0..s.k.len()).collect();
             order.sort_by(|&a, &b| s.k[a].total_cmp(&s.k[b]));
             let sorted = |v: &[f64]| order.iter().map(|&j| v[j]).collect::<Vec<f64>>();
@@ -175,9 +159,8 @@ pub fn k_study(path: &Path, title: &str, series: &[KSeries]) -> Result<(), PlotE
                     },
                 );
             }
-            p.finish()?;
-        }
-        Ok(())
+            Ok(())
+        })
     })
 }
 

@@ -140,6 +140,42 @@ pub(crate) fn titled<'b>(root: &Area<'b>, title: &str) -> Result<Area<'b>, PlotE
 
 /// Splits `area` into `n` rows of equal plot height, the last one `extra` pixels taller
 /// (room for the x labels).
+/// Panels stacked on `body`, one per entry of `y_axes` (axis, log scale, description), sharing
+/// the x axis: tick labels and the x description on the last only, a note where a row had no
+/// finite data (its axis `None`), and `draw` filling each before it is finished.
+pub(crate) fn stacked_panels<'b>(
+    root: &Area<'b>,
+    body: &Area<'b>,
+    x: &Axis,
+    x_desc: &str,
+    y_axes: &[(Option<Axis>, bool, String)],
+    mut draw: impl FnMut(usize, &mut Panel<'_, 'b>) -> Result<(), PlotError>,
+) -> Result<(), PlotError> {
+    let y_area = y_label_area(root, y_axes.iter().filter_map(|(a, _, _)| a.as_ref()));
+    let rows = stack_rows(body, y_axes.len(), X_AREA);
+    for (i, ((axis, log, y_desc), area)) in y_axes.iter().zip(&rows).enumerate() {
+        let last = i + 1 == y_axes.len();
+        let mut p = Panel::new(
+            area,
+            PanelSpec {
+                x: x.clone(),
+                y: axis.clone().unwrap_or_else(|| Axis::fallback(*log)),
+                x_desc,
+                y_desc,
+                x_ticks: last,
+                x_area: if last { X_AREA } else { 0 },
+                y_area,
+            },
+        )?;
+        if axis.is_none() {
+            p.note("no finite data")?;
+        }
+        draw(i, &mut p)?;
+        p.finish()?;
+    }
+    Ok(())
+}
+
 pub(crate) fn stack_rows<'b>(area: &Area<'b>, n: usize, extra: u32) -> Vec<Area<'b>> {
     let (_, h) = area.dim_in_pixel();
     let row = (h.saturating_sub(extra) as usize / n.max(1)) as i32;
