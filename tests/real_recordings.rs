@@ -284,7 +284,7 @@ fn bad_drive_models_are_refused_with_their_field() {
 }
 
 #[test]
-#[ignore = "whole EMPS record: about 6 min on 2 cores; run before resolving"]
+#[ignore = "whole EMPS record: a few minutes on 2 cores; run before resolving"]
 fn the_whole_emps_record_names_coulomb_friction_and_the_offset() {
     let Some(dir) = real_dir() else { return };
     let mut o = options(

@@ -565,6 +565,12 @@ mod tests {
                 "unknown base model",
             ),
             (
+                "schema = 2\n[discrepancy]\nbasis = \"bspline\"\ndegree = 2\n",
+                4,
+                "discrepancy.degree",
+                "B-spline basis needs degree",
+            ),
+            (
                 "schema = 2\n[discrepancy]\ndegree = 99\n",
                 3,
                 "discrepancy.degree",

@@ -468,3 +468,46 @@ fn coefficient_marginals_write_png_and_refuse_mismatched_lengths() {
     assert!(coefficient_marginals(&bad, "bad", &[broken]).is_err());
     assert!(!bad.exists());
 }
+
+fn missing_torque_example() -> MissingTorquePlot {
+    let speed: Vec<f64> = (0..40).map(|i| -0.12 + 0.006 * i as f64).collect();
+    let before = speed
+        .iter()
+        .map(|v| 20.0 * v.signum() - 200.0 * v)
+        .collect();
+    let after = speed.iter().map(|v| 0.5 * (30.0 * v).sin()).collect();
+    MissingTorquePlot {
+        title: "the torque the model misses, against speed".into(),
+        speed_unit: "m/s".into(),
+        torque_unit: "N".into(),
+        curves: vec![
+            MissingTorqueCurve {
+                label: "before".into(),
+                speed: speed.clone(),
+                torque: before,
+            },
+            MissingTorqueCurve {
+                label: "after".into(),
+                speed,
+                torque: after,
+            },
+        ],
+    }
+}
+
+#[test]
+fn missing_torque_writes_png() {
+    let p = out("missing_torque");
+    missing_torque(&p, &missing_torque_example()).unwrap();
+    assert_png(&p);
+}
+
+#[test]
+fn missing_torque_rejects_empty_and_inconsistent_input() {
+    let p = out("missing_torque_bad");
+    let mut plot = missing_torque_example();
+    plot.curves[0].torque.pop();
+    assert_err_no_file(&p, missing_torque(&p, &plot));
+    plot.curves.clear();
+    assert_err_no_file(&p, missing_torque(&p, &plot));
+}
