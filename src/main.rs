@@ -141,6 +141,10 @@ struct ChainArgs {
     /// No progress bars.
     #[arg(long)]
     quiet: bool,
+    /// HMC/NUTS warm-up: keep the Laplace metric and tune the step size (laplace; the default,
+    /// but windows for `reproduce table1`), or re-estimate the metric in Stan's windows.
+    #[arg(long, value_enum)]
+    metric_adaptation: Option<app::run::MetricAdaptation>,
 }
 
 impl ChainArgs {
@@ -149,22 +153,43 @@ impl ChainArgs {
     }
 
     /// A run of `sampler` with these chains (default 4), seed and quietness.
+    /// A run's settings; a warm-up not given is the sampler's default for the metric
+    /// adaptation (see `app::run::default_warmup`).
     fn run(
         &self,
         sampler: app::run::SamplerKind,
-        warmup: usize,
+        warmup: Option<usize>,
         draws: usize,
     ) -> app::run::RunSettings {
+        self.run_adapting(
+            sampler,
+            warmup,
+            draws,
+            app::run::MetricAdaptation::default(),
+        )
+    }
+
+    /// As [`ChainArgs::run`], with a command's own default metric adaptation.
+    fn run_adapting(
+        &self,
+        sampler: app::run::SamplerKind,
+        warmup: Option<usize>,
+        draws: usize,
+        default_metric: app::run::MetricAdaptation,
+    ) -> app::run::RunSettings {
+        let metric_adaptation = self.metric_adaptation.unwrap_or(default_metric);
         app::run::RunSettings {
             sampler,
             chains: self.chains_or(4),
             chain: motorcal::sampler::ChainSettings {
-                warmup,
+                warmup: warmup
+                    .unwrap_or_else(|| app::run::default_warmup(sampler, metric_adaptation)),
                 draws,
                 keep: None,
             },
             seed: self.seed,
             quiet: self.quiet,
+            metric_adaptation,
             ..app::run::RunSettings::default()
         }
     }
@@ -209,8 +234,9 @@ struct RunArgs {
     sampler: app::run::SamplerKind,
     #[command(flatten)]
     chains: ChainArgs,
-    #[arg(long, default_value_t = 1000)]
-    warmup: usize,
+    /// Warm-up per chain (default: 100 for HMC/NUTS on the Laplace metric, else 1000).
+    #[arg(long)]
+    warmup: Option<usize>,
     #[arg(long, default_value_t = 1000)]
     draws: usize,
     /// Keep only the last N draws of each chain.
@@ -300,10 +326,10 @@ struct SweepArgs {
     sampler: app::run::SamplerKind,
     #[command(flatten)]
     chains: ChainArgs,
-    /// Warm-up per chain: 300 is the shortest that keeps R-hat and ESS at every K with the
-    /// fastest whole sweep (papers/john2018, "The warm-up").
-    #[arg(long, default_value_t = 300)]
-    warmup: usize,
+    /// Warm-up per chain (default: 100 for HMC/NUTS on the Laplace metric, which keeps R-hat
+    /// and ESS at every K; else 1000; papers/john2018, "The warm-up").
+    #[arg(long)]
+    warmup: Option<usize>,
     #[arg(long, default_value_t = 1000)]
     draws: usize,
     #[arg(long, default_value = "out/sweep")]
@@ -485,9 +511,14 @@ struct DiagnoseArgs {
 }
 
 fn diagnose(args: DiagnoseArgs) -> Result<(), AppError> {
-    let run = args
-        .chains
-        .run(app::run::SamplerKind::NutsDense, args.warmup, args.draws);
+    // Candidate terms have one-sided supports, where the Laplace approximation can be poor:
+    // diagnose's fits refine the metric in Stan's windows unless told otherwise.
+    let run = args.chains.run_adapting(
+        app::run::SamplerKind::NutsDense,
+        Some(args.warmup),
+        args.draws,
+        app::run::MetricAdaptation::Windows,
+    );
     let options = app::diagnose::DiagnoseOptions {
         data: args.data,
         model: args.model,
@@ -574,6 +605,7 @@ fn bench(args: BenchArgs) -> Result<(), AppError> {
             decay_power: args.prior_decay,
             ..CoefficientPrior::default()
         },
+        metric_adaptation: args.chains.metric_adaptation.unwrap_or_default(),
     };
     let records = app::bench::bench(&options)?;
     print!("{}", app::bench::format_table(&records));
@@ -595,6 +627,10 @@ fn table1(args: Table1Args) -> Result<(), AppError> {
         threads: args.threads,
         out: args.out,
         quiet: args.chains.quiet,
+        metric_adaptation: args
+            .chains
+            .metric_adaptation
+            .unwrap_or(app::table1::Table1Options::default().metric_adaptation),
     })
 }
 

@@ -12,7 +12,10 @@ use crate::synthetic::DEFAULT_SEED;
 
 use super::AppError;
 use super::problem::Problem;
-use super::run::{RunCost, RunOutput, RunSettings, SamplerKind, ratio_2sf, run_sampler};
+use super::run::{
+    MetricAdaptation, RunCost, RunOutput, RunSettings, SamplerKind, default_warmup, ratio_2sf,
+    run_sampler,
+};
 
 /// The K values of the study unless told otherwise.
 pub const DEFAULT_KS: [usize; 7] = [0, 3, 6, 9, 12, 15, 20];
@@ -41,6 +44,8 @@ pub struct BenchOptions {
     pub from_json: Option<PathBuf>,
     /// The discrepancy coefficients' prior (§5's decaying variance, or the paper's).
     pub coefficient_prior: crate::bayes::CoefficientPrior,
+    /// How HMC and NUTS tune their metric in warm-up.
+    pub metric_adaptation: MetricAdaptation,
 }
 
 impl Default for BenchOptions {
@@ -63,6 +68,7 @@ impl Default for BenchOptions {
             quiet: false,
             from_json: None,
             coefficient_prior: crate::bayes::CoefficientPrior::default(),
+            metric_adaptation: MetricAdaptation::default(),
         }
     }
 }
@@ -91,13 +97,17 @@ pub struct BenchRecord {
     /// The coefficient prior the run used (empty in files written before it was recorded).
     #[serde(default)]
     pub prior: String,
+    /// How HMC and NUTS tuned their metric ("laplace" or "windows"; empty for the other
+    /// samplers and in files written before it was recorded).
+    #[serde(default)]
+    pub metric_adaptation: String,
 }
 
 fn first_attempt(sampler: SamplerKind, options: &BenchOptions) -> ChainSettings {
     let (warmup, draws) = match sampler {
         SamplerKind::Metropolis => (500, 5000),
         SamplerKind::AdaptiveMetropolis => (5000, 5000),
-        _ => (1000, 1000),
+        _ => (default_warmup(sampler, options.metric_adaptation), 1000),
     };
     ChainSettings {
         warmup: options.warmup.unwrap_or(warmup),
@@ -132,6 +142,7 @@ fn run_until_converged(
             seed: options.seed,
             threads: Some(threads),
             quiet: options.quiet,
+            metric_adaptation: options.metric_adaptation,
             ..RunSettings::default()
         };
         let run = run_sampler(posterior, &settings, label)?;
@@ -165,6 +176,7 @@ fn record(
         divergences: run.divergences,
         cost: RunCost::of(run, sampler.uses_gradient()),
         prior: crate::bayes::CoefficientPrior::default().label(),
+        metric_adaptation: String::new(),
     }
 }
 
@@ -222,6 +234,11 @@ pub fn bench(options: &BenchOptions) -> Result<Vec<BenchRecord>, AppError> {
                     run_until_converged(&mut posterior, sampler, threads, options, &label)?;
                 let r = BenchRecord {
                     prior: options.coefficient_prior.label(),
+                    metric_adaptation: if sampler.is_hamiltonian() {
+                        options.metric_adaptation.name().into()
+                    } else {
+                        String::new()
+                    },
                     ..record(sampler, k, threads, options.chains, &chain, &run)
                 };
                 if !options.quiet {
@@ -345,12 +362,12 @@ fn write_records(options: &BenchOptions, records: &[BenchRecord]) -> Result<(), 
         "sampler,k,threads,chains,warmup,draws,min_ess_bulk,max_rhat,converged,lower_bound,divergences,\
          wall_s,map_wall_s,map_cpu_s,warmup_wall_s,warmup_cpu_s,sampling_wall_s,sampling_cpu_s,total_cpu_s,\
          eval_kind,evaluations,all_evaluations,\
-         min_ess_per_s,min_ess_per_total_s,min_ess_per_wall_s,min_ess_per_eval,min_ess_per_all_evals,prior\n",
+         min_ess_per_s,min_ess_per_total_s,min_ess_per_wall_s,min_ess_per_eval,min_ess_per_all_evals,prior,metric_adaptation\n",
     );
     for r in records {
         let c = &r.cost;
         csv.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},\"{}\"\n",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},\"{}\",{}\n",
             r.sampler,
             r.k,
             r.threads,
@@ -378,7 +395,8 @@ fn write_records(options: &BenchOptions, records: &[BenchRecord]) -> Result<(), 
             c.min_ess_per_wall_s,
             c.min_ess_per_eval,
             c.min_ess_per_all_evals,
-            r.prior
+            r.prior,
+            r.metric_adaptation
         ));
     }
     crate::io::write_atomically(&options.out.join("bench.csv"), csv.as_bytes())?;
