@@ -361,6 +361,46 @@ fn one_hsm150_record_of_each_direction_names_coulomb_friction_and_the_documented
 }
 
 #[test]
+#[ignore = "each whole HSM150 record alone: about 6 min on 2 cores; run before resolving"]
+fn each_hsm150_record_alone_names_one_torque_of_the_tied_pair_not_the_commands_step() {
+    let Some(dir) = real_dir() else { return };
+    for name in ["idf_pos_0.06_1", "idf_neg_0.04_1"] {
+        let mut o = options(
+            vec![dir.join(format!("hsm150/{name}.csv"))],
+            example("hsm150"),
+            &[],
+        );
+        o.candidates = None;
+        let d = diagnose(&o).unwrap();
+        println!("{name}:\n{}", motorcal::app::diagnose::format_diagnosis(&d));
+        let pair = ["coulomb_friction", "load_torque"];
+        assert!(
+            d.selected_set.iter().any(|s| pair.contains(&s.as_str())),
+            "{name}: {:?}",
+            d.selected_set
+        );
+        assert!(
+            d.tied_pairs
+                .iter()
+                .any(|p| p.iter().all(|t| pair.contains(&t.as_str()))),
+            "{name}: {:?}",
+            d.tied_pairs
+        );
+        // The command steps at t = 10 s; the measured current steps with it.
+        let load_step = d.ranking.iter().find(|e| e.effect == "load_step").unwrap();
+        let c = load_step
+            .coincides_with_input_step
+            .as_ref()
+            .expect("the single load step is marked with the current's step");
+        assert!((c.input_step.time - 10.0).abs() < 0.2, "{name}: {c:?}");
+        if d.selected_set.iter().any(|s| s == "load_step") {
+            let t_s = d.selected_params["load_step.t_s"];
+            assert!((t_s - 10.0).abs() > 1.0, "{name}: a load step at {t_s} s");
+        }
+    }
+}
+
+#[test]
 fn records_in_one_direction_are_told_from_records_that_reverse() {
     let Some(dir) = real_dir() else { return };
     let emps = window(&dir.join("emps/emps_estimation.csv"), 4000, "emps-4s-b.csv");

@@ -56,6 +56,9 @@ pub struct CandidateFit {
     /// The importance-sampling check of the Laplace evidence, where it was run; the score then
     /// includes its correction.
     pub confirmation: Option<super::confirm::Confirmation>,
+    /// A switching time fitted at a step of a recorded input: confounded with the input, so
+    /// ranked but never selected.
+    pub coincidence: Option<super::coincide::InputCoincidence>,
 }
 
 /// The problem with `added` switched on (at their defaults) and calibrated with their default
@@ -151,6 +154,7 @@ pub fn fit_candidate_from(
             at_bound.push(c.name.clone());
         }
     }
+    let coincidence = super::coincide::coincidence(&problem, &mut posterior, &map)?;
     Ok(CandidateFit {
         added: added.to_vec(),
         n_added,
@@ -161,6 +165,7 @@ pub fn fit_candidate_from(
         theta,
         at_bound,
         confirmation: None,
+        coincidence,
     })
 }
 

@@ -13,6 +13,7 @@
 //! 7.4) positive evidence; the multiplicity of twelve candidates is why it is not 1.
 
 mod candidates;
+mod coincide;
 mod confirm;
 mod fits;
 mod report;
@@ -28,6 +29,7 @@ use rayon::prelude::*;
 pub use candidates::{
     BOUNDED_STARTS, CandidateFit, answer_params, fit_candidate, fit_candidate_from, problem_with,
 };
+pub use coincide::{InputCoincidence, InputStep, input_steps};
 pub use confirm::{Confirmation, importance_evidence};
 pub use fits::{FitSummary, Mismatch, Whiteness, ljung_box};
 pub use report::{Diagnosis, RankEntry, format_diagnosis};
@@ -150,21 +152,47 @@ fn confirm_leaders(problem: &Problem, fits: &mut [CandidateFit]) -> Result<(), A
     Ok(())
 }
 
-/// Greedy forward selection from the best single candidate: the next term joins while it
-/// raises the score by more than the threshold.
+/// What the forward selection chose.
+#[derive(Clone, Debug)]
+pub struct Selection {
+    pub terms: Vec<String>,
+    pub fit: CandidateFit,
+    /// Fits that would have been selected at some step but switch at a step of a recorded input
+    /// (see `coincide.rs`): confounded with the input, so passed over.
+    pub passed_over: Vec<CandidateFit>,
+}
+
+/// Greedy forward selection from the best single candidate whose switching time (if it has
+/// one) does not coincide with an input step: the next term joins while it raises the score by
+/// more than the threshold.
 pub fn forward_selection(
     problem: &Problem,
     ranking: &[CandidateFit],
     candidates: &[String],
-) -> Result<(Vec<String>, CandidateFit), AppError> {
+) -> Result<Selection, AppError> {
     let none = ranking
         .iter()
         .find(|f| f.added.is_empty())
         .expect("the ranking holds the model without terms")
         .clone();
-    let best = &ranking[0];
-    if best.added.is_empty() || best.score - none.score <= EVIDENCE_THRESHOLD {
-        return Ok((Vec::new(), none));
+    let beats =
+        |fit: &CandidateFit, base: &CandidateFit| fit.score - base.score > EVIDENCE_THRESHOLD;
+    let mut passed_over: Vec<CandidateFit> = ranking
+        .iter()
+        .take_while(|f| f.coincidence.is_some())
+        .filter(|f| beats(f, &none))
+        .cloned()
+        .collect();
+    let best = ranking
+        .iter()
+        .find(|f| f.coincidence.is_none())
+        .expect("the model without terms has no switching time");
+    if best.added.is_empty() || !beats(best, &none) {
+        return Ok(Selection {
+            terms: Vec::new(),
+            fit: none,
+            passed_over,
+        });
     }
     let mut current = best.clone();
     // On records that never reverse, Coulomb friction and a load torque are one torque (they
@@ -195,17 +223,33 @@ pub fn forward_selection(
             .map(|added| fit_candidate_from(problem, added, Some(&current)))
             .collect::<Result<Vec<_>, _>>()?;
         let mut next: Option<CandidateFit> = None;
+        let mut confounded: Vec<CandidateFit> = Vec::new();
         for fit in fits {
-            if next.as_ref().is_none_or(|n| fit.score > n.score) {
+            if fit.coincidence.is_some() {
+                confounded.push(fit);
+            } else if next.as_ref().is_none_or(|n| fit.score > n.score) {
                 next = Some(fit);
             }
         }
+        // Reported only where it would have been chosen: above the threshold and the best.
+        let chosen = next
+            .as_ref()
+            .map_or(current.score, |n| n.score.max(current.score));
+        passed_over.extend(
+            confounded
+                .into_iter()
+                .filter(|f| beats(f, &current) && f.score > chosen),
+        );
         match next {
-            Some(fit) if fit.score - current.score > EVIDENCE_THRESHOLD => current = fit,
+            Some(fit) if beats(&fit, &current) => current = fit,
             _ => break,
         }
     }
-    Ok((current.added.clone(), current))
+    Ok(Selection {
+        terms: current.added.clone(),
+        fit: current,
+        passed_over,
+    })
 }
 
 /// The whole diagnosis.
@@ -229,7 +273,7 @@ pub fn diagnose(options: &DiagnoseOptions) -> Result<Diagnosis, AppError> {
     let candidates = candidate_names(&problem, options.candidates.as_deref())?;
     let ranking = rank(&problem, &candidates)?;
     let ranking_s = started.elapsed().as_secs_f64();
-    let (selected_set, selected_fit) = forward_selection(&problem, &ranking, &candidates)?;
+    let selection = forward_selection(&problem, &ranking, &candidates)?;
     let selection_s = started.elapsed().as_secs_f64();
     report::assemble(
         &problem,
@@ -237,8 +281,7 @@ pub fn diagnose(options: &DiagnoseOptions) -> Result<Diagnosis, AppError> {
         k,
         &candidates,
         ranking,
-        selected_set,
-        selected_fit,
+        selection,
         started,
         [ranking_s, selection_s],
     )

@@ -15,11 +15,12 @@ use crate::io::write_model_file;
 use crate::motor::Term;
 
 use super::candidates::{CandidateFit, answer_params};
+use super::coincide::InputCoincidence;
 use super::fits::{self, Convergence, FitSummary, Mismatch, SampledFit};
 use super::screen::collinear_pairs;
 use super::state::{StateFingerprint, fingerprint, reading};
 use super::ties::{separating_input, truth_problem};
-use super::{DiagnoseOptions, EVIDENCE_THRESHOLD};
+use super::{DiagnoseOptions, EVIDENCE_THRESHOLD, Selection};
 
 #[derive(Clone, Debug, Serialize)]
 pub struct RankEntry {
@@ -35,6 +36,19 @@ pub struct RankEntry {
     pub at_bound: Vec<String>,
     /// The importance-sampling check of the Laplace evidence, for a doubtful leader.
     pub confirmation: Option<super::confirm::Confirmation>,
+    /// The input step its switching time coincides with: confounded with the input, not
+    /// selected.
+    pub coincides_with_input_step: Option<InputCoincidence>,
+}
+
+/// A fit the selection passed over because its switching time coincides with an input step.
+#[derive(Clone, Debug, Serialize)]
+pub struct PassedOver {
+    /// The terms of that fit, in the order they were added.
+    pub terms: Vec<String>,
+    /// Its score against the model as given.
+    pub score: f64,
+    pub coincidence: InputCoincidence,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -50,6 +64,8 @@ pub struct Diagnosis {
     /// tell apart (Coulomb friction and a load torque on records that never reverse), with
     /// the experiment in `tie_experiments` under `a/b`.
     pub tied_pairs: Vec<[String; 2]>,
+    /// Fits that would have been selected but switch at a step of a recorded input.
+    pub passed_over: Vec<PassedOver>,
     /// For each tie, the input that would separate it from `selected`.
     pub tie_experiments: BTreeMap<String, String>,
     pub mismatch: Vec<Mismatch>,
@@ -83,7 +99,45 @@ fn entry(fit: &CandidateFit, none: &CandidateFit) -> RankEntry {
         params: answer_params(fit),
         at_bound: fit.at_bound.clone(),
         confirmation: fit.confirmation,
+        coincides_with_input_step: fit.coincidence.clone(),
     }
+}
+
+/// Why a switching time at an input step is not selected, in words.
+fn passed_over_note(p: &PassedOver) -> String {
+    let c = &p.coincidence;
+    let step = &c.input_step;
+    let (which, why) = if step.record_start {
+        (
+            "the record's start, where it applies the recorded input",
+            "a step at the start is a constant load (load_torque, and on a record that never \
+             reverses the same torque as Coulomb friction)",
+        )
+    } else {
+        (
+            "the step of the recorded input",
+            "a change when the input changes cannot be told from the input acting differently \
+             than modelled (a gain on the increment, a friction map not affine in speed, the \
+             drive's response)",
+        )
+    };
+    format!(
+        "{} (score {:+.2}) switches at {} = {:.4} s, {:.4} s from {which} {} at {:.4} s (by \
+         {:+.4}), within the time resolution {:.4} s (2 sd of the switching time, {:.4} s with \
+         the residuals' autocorrelation of {:.0} samples, and of the step's time, + one \
+         sample): {why}, so it is not selected",
+        p.terms.join(" + "),
+        p.score,
+        c.parameter,
+        c.switching_time,
+        (c.switching_time - step.time).abs(),
+        step.input,
+        step.time,
+        step.size,
+        c.resolution,
+        c.switching_time_sd,
+        c.residual_autocorrelation
+    )
 }
 
 /// The noise σ of each channel at the MAP of the selected model (the noise the simulated
@@ -103,8 +157,7 @@ pub fn assemble(
     k: usize,
     candidates: &[String],
     ranking: Vec<CandidateFit>,
-    selected_set: Vec<String>,
-    selected_fit: CandidateFit,
+    selection: Selection,
     started: Instant,
     [ranking_s, selection_s]: [f64; 2],
 ) -> Result<Diagnosis, AppError> {
@@ -113,6 +166,21 @@ pub fn assemble(
         .find(|f| f.added.is_empty())
         .expect("none is ranked")
         .clone();
+    let Selection {
+        terms: selected_set,
+        fit: selected_fit,
+        passed_over,
+    } = selection;
+    let passed_over: Vec<PassedOver> = passed_over
+        .iter()
+        .filter_map(|f| {
+            Some(PassedOver {
+                terms: f.added.clone(),
+                score: f.score - none.score,
+                coincidence: f.coincidence.clone()?,
+            })
+        })
+        .collect();
     let selected = selected_set
         .first()
         .cloned()
@@ -126,7 +194,11 @@ pub fn assemble(
             let Some(name) = other.added.first() else {
                 continue;
             };
-            if name == &selected || first.score - other.score > EVIDENCE_THRESHOLD {
+            // A fit confounded with an input step is no rival: it is never selected.
+            if name == &selected
+                || other.coincidence.is_some()
+                || first.score - other.score > EVIDENCE_THRESHOLD
+            {
                 continue;
             }
             match separating_input(
@@ -154,6 +226,7 @@ pub fn assemble(
             ));
         }
     }
+    notes.extend(passed_over.iter().map(passed_over_note));
     let resistance = none.theta.get("R").copied().unwrap_or(f64::NAN);
     let none_noise = noise_at_map(problem, &none)?;
     for (a, b, cos) in collinear_pairs(problem, candidates, resistance, &none_noise)? {
@@ -203,6 +276,7 @@ pub fn assemble(
         ranking: ranking.iter().map(|f| entry(f, &none)).collect(),
         ties,
         tied_pairs,
+        passed_over,
         tie_experiments,
         mismatch: Vec::new(),
         state,
@@ -419,11 +493,21 @@ pub fn format_diagnosis(d: &Diagnosis) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "ranking (score: log L − ½·d·ln N against none, nats):");
     for e in &d.ranking {
-        let _ = writeln!(
+        let _ = write!(
             s,
             "  {:<20} {:>+10.2}   Laplace (default priors) {:>+10.2}",
             e.effect, e.score, e.log_evidence_laplace
         );
+        match &e.coincides_with_input_step {
+            Some(c) => {
+                let _ = writeln!(
+                    s,
+                    "   at the {} step at {:.4} s: not selected",
+                    c.input_step.input, c.input_step.time
+                );
+            }
+            None => s.push('\n'),
+        }
     }
     if d.selected_set.is_empty() {
         let _ = writeln!(

@@ -21,7 +21,7 @@ use super::ties::truth_problem;
 /// Smoothing window of the measured speed and input before differentiating [s]: 20 ms, short
 /// against the mechanical time constants (0.5 s on EMPS, 1.7 s on HSM150) and long against
 /// 1-ms sampling, whose quantised speed would otherwise make ω̇ pure noise.
-const SMOOTHING_S: f64 = 0.02;
+pub(super) const SMOOTHING_S: f64 = 0.02;
 
 /// Speed bins of the figure.
 const BINS: usize = 40;
