@@ -3,7 +3,7 @@
 //! whether the 95% interval of R holds R₀ = 0.1.
 //!
 //! cargo run --release --example k_seeds -- [--seeds 20] [--first 1] [--warmup 500] [--draws 500]
-//!     [--out papers/john2018/k-seeds]
+//!     [--out papers/john2018/k-seeds] [--metric-adaptation laplace|windows]
 
 use std::path::PathBuf;
 
@@ -13,7 +13,7 @@ use motorcal::app::problem::Problem;
 use motorcal::app::sweep::select::{evidence, sigma_stabilisation};
 use motorcal::app::sweep::{SweepOptions, SweepRecord, run_k};
 use motorcal::bayes::{CoefficientPrior, ModelSettings};
-use motorcal::pipeline::{RunSettings, SamplerKind, run_sampler};
+use motorcal::pipeline::{MetricAdaptation, RunSettings, SamplerKind, run_sampler};
 use motorcal::sampler::ChainSettings;
 
 #[derive(Serialize)]
@@ -47,6 +47,15 @@ fn main() {
     let warmup: usize = arg(&args, "--warmup", 500);
     let draws: usize = arg(&args, "--draws", 500);
     let out = PathBuf::from(arg(&args, "--out", "papers/john2018/k-seeds".to_string()));
+    let metric_adaptation = match arg(&args, "--metric-adaptation", "laplace".to_string()).as_str()
+    {
+        "laplace" => MetricAdaptation::Laplace,
+        "windows" => MetricAdaptation::Windows,
+        other => {
+            eprintln!("--metric-adaptation {other}: expected laplace or windows");
+            std::process::exit(2);
+        }
+    };
     let run = RunSettings {
         sampler: SamplerKind::NutsDense,
         chains: 4,
@@ -56,6 +65,7 @@ fn main() {
             keep: None,
         },
         quiet: true,
+        metric_adaptation,
         ..RunSettings::default()
     };
     let r0 = 0.1;
