@@ -55,6 +55,8 @@ fn run_settings() -> RunSettings {
             keep: None,
         },
         quiet: true,
+        // As `motorcal diagnose` runs its fits.
+        metric_adaptation: motorcal::pipeline::MetricAdaptation::Windows,
         ..RunSettings::default()
     }
 }

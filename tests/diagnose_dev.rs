@@ -37,6 +37,8 @@ fn run(case: &Path, rank_only: bool) -> Diagnosis {
                 draws: 400,
                 keep: None,
             },
+            // As `motorcal diagnose` runs its fits.
+            metric_adaptation: motorcal::pipeline::MetricAdaptation::Windows,
             ..RunSettings::default()
         },
         out: None,
