@@ -55,8 +55,7 @@ fn run_settings() -> RunSettings {
             keep: None,
         },
         quiet: true,
-        // As `motorcal diagnose` runs its fits.
-        metric_adaptation: motorcal::pipeline::MetricAdaptation::Windows,
+        metric_adaptation: motorcal::app::diagnose::METRIC_ADAPTATION,
         ..RunSettings::default()
     }
 }

@@ -152,8 +152,7 @@ impl ChainArgs {
         self.chains.unwrap_or(default)
     }
 
-    /// A run of `sampler` with these chains (default 4), seed and quietness.
-    /// A run's settings; a warm-up not given is the sampler's default for the metric
+    /// A run of `sampler` with these chains (default 4), seed and quietness; a warm-up not given is the sampler's default for the metric
     /// adaptation (see `app::run::default_warmup`).
     fn run(
         &self,
@@ -511,13 +510,11 @@ struct DiagnoseArgs {
 }
 
 fn diagnose(args: DiagnoseArgs) -> Result<(), AppError> {
-    // Candidate terms have one-sided supports, where the Laplace approximation can be poor:
-    // diagnose's fits refine the metric in Stan's windows unless told otherwise.
     let run = args.chains.run_adapting(
         app::run::SamplerKind::NutsDense,
         Some(args.warmup),
         args.draws,
-        app::run::MetricAdaptation::Windows,
+        app::diagnose::METRIC_ADAPTATION,
     );
     let options = app::diagnose::DiagnoseOptions {
         data: args.data,

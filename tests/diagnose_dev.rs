@@ -37,8 +37,7 @@ fn run(case: &Path, rank_only: bool) -> Diagnosis {
                 draws: 400,
                 keep: None,
             },
-            // As `motorcal diagnose` runs its fits.
-            metric_adaptation: motorcal::pipeline::MetricAdaptation::Windows,
+            metric_adaptation: motorcal::app::diagnose::METRIC_ADAPTATION,
             ..RunSettings::default()
         },
         out: None,

@@ -146,7 +146,7 @@ pub const LAPLACE_WARMUP: usize = 100;
 /// The mean acceptance statistic dual averaging aims at on the Laplace metric, above Stan's
 /// 0.8. The whitened target is nearly isotropic, so the step size lands near the leapfrog's
 /// stability limit; where the posterior's curvature grows away from the MAP (R traded against
-/// δ at large K) 0.8 left 3–22 divergent transitions in 4000 at K = 19 on four data seeds,
+/// δ at large K) 0.8 left 3–22 divergent transitions in 4000 at K = 19 on four chain seeds,
 /// where Stan's windows, which settle on smaller steps, left 0–3. Raising the target is
 /// Stan's own remedy for divergences: 0.85 left at most one per K from 17 to 20, at 13–47%
 /// more gradients at K = 19 (papers/john2018, "The warm-up").

@@ -53,6 +53,11 @@ pub const MAX_TERMS: usize = 3;
 /// the physics a few more per channel.
 pub const MIN_SAMPLES: usize = 50;
 
+/// How diagnose's sampled fits tune the NUTS metric unless told otherwise: candidate terms have
+/// one-sided supports, where the Laplace approximation can be poor, so Stan's windows refine it.
+pub const METRIC_ADAPTATION: crate::pipeline::MetricAdaptation =
+    crate::pipeline::MetricAdaptation::Windows;
+
 /// The discrepancy degree of the locating fit when none is given: the paper's choice for its
 /// 501-sample records (§4.2).
 pub const DEFAULT_K: usize = 9;
