@@ -36,6 +36,12 @@ impl std::fmt::Display for DensityError {
 
 impl std::error::Error for DensityError {}
 
+impl From<DensityError> for crate::error::Error {
+    fn from(e: DensityError) -> Self {
+        crate::error::Error::Numerical(e.message)
+    }
+}
+
 /// An unnormalised log density. `&mut self` lets an implementation keep scratch space and
 /// caches (the motor posterior reuses G(θ) while only noise or discrepancy parameters move).
 /// A point outside the support returns `Ok(f64::NEG_INFINITY)`.

@@ -14,6 +14,7 @@ pub mod app;
 pub mod bayes;
 pub mod density;
 pub mod diagnostics;
+pub mod error;
 pub mod evidence;
 pub mod forward;
 pub mod io;

@@ -18,6 +18,7 @@ pub mod table1;
 use std::fmt;
 
 use crate::density::DensityError;
+use crate::error::Error;
 use crate::io::InputError;
 
 /// Everything a command can fail with, printed as one line by the binary.
@@ -46,6 +47,33 @@ impl From<InputError> for AppError {
     fn from(e: InputError) -> Self {
         AppError::Input(e)
     }
+}
+
+/// A library error as the command line says it: a setting is named by its flag.
+impl From<Error> for AppError {
+    fn from(e: Error) -> Self {
+        match e {
+            Error::Input(e) => AppError::Input(e),
+            Error::Settings(e) if e.name.is_empty() => AppError::Usage(e.message),
+            Error::Settings(e) => AppError::Usage(format!(
+                "{}{}: {}",
+                flag(&e.name),
+                e.value.map(|v| format!(" {v}")).unwrap_or_default(),
+                e.message
+            )),
+            Error::Numerical(m) => AppError::Numerical(m),
+            Error::Output(m) => AppError::Output(m),
+        }
+    }
+}
+
+/// The flag of a settings field: `chains` → `--chains`, `keep/draws` → `--keep/--draws`.
+pub fn flag(field: &str) -> String {
+    field
+        .split('/')
+        .map(|f| format!("--{}", f.replace('_', "-")))
+        .collect::<Vec<_>>()
+        .join("/")
 }
 
 impl From<DensityError> for AppError {

@@ -31,7 +31,7 @@ use crate::sampler::metropolis::{Metropolis, PyMc3Tuning};
 use crate::sampler::nuts::{Nuts, NutsSettings};
 use crate::sampler::{Adaptation, ChainOutput, ChainSettings, Kernel, run_chains};
 
-use crate::app::AppError;
+use crate::error::{Error, InputError};
 
 pub mod cost;
 pub use cost::{RunCost, ratio_2sf};
@@ -200,20 +200,20 @@ impl Default for RunSettings {
 }
 
 impl RunSettings {
-    pub fn validate(&self) -> Result<(), AppError> {
+    pub fn validate(&self) -> Result<(), Error> {
         if self.chains == 0 {
-            return Err(AppError::Usage(
-                "--chains 0: need at least one chain".into(),
-            ));
+            return Err(Error::setting("chains", 0, "need at least one chain"));
         }
         if self.threads == Some(0) {
-            return Err(AppError::Usage(
-                "--threads 0: need at least one thread".into(),
-            ));
+            return Err(Error::setting("threads", 0, "need at least one thread"));
         }
-        self.chain
-            .validate()
-            .map_err(|e| AppError::Usage(format!("--keep/--draws: {e}")))?;
+        self.chain.validate().map_err(|e| {
+            Error::Settings(crate::error::SettingError {
+                name: "keep/draws".into(),
+                value: None,
+                message: e.to_string(),
+            })
+        })?;
         Ok(())
     }
 }
@@ -262,7 +262,7 @@ impl RunOutput {
 }
 
 /// The MAP from the posterior's own starting point.
-pub fn map_estimate<P: Fittable>(posterior: &mut P) -> Result<MapEstimate, AppError> {
+pub fn map_estimate<P: Fittable>(posterior: &mut P) -> Result<MapEstimate, Error> {
     let start = posterior.initial_point()?;
     Ok(find_map(posterior, &start, &MapSettings::default())?)
 }
@@ -275,9 +275,9 @@ pub fn initial_points<P: LogDensity>(
     chains: usize,
     dispersion: f64,
     seed: u64,
-) -> Result<Vec<Vec<f64>>, AppError> {
+) -> Result<Vec<Vec<f64>>, Error> {
     let d = map.x.len();
-    let (l_inv_t, _) = map.whitening().map_err(AppError::Numerical)?;
+    let (l_inv_t, _) = map.whitening().map_err(Error::Numerical)?;
     let mut inits = Vec::with_capacity(chains);
     for chain in 0..chains {
         let mut rng = chain_rng(seed ^ 0x1a17_0000, chain);
@@ -328,7 +328,7 @@ pub fn execute<P, K, A, F>(
     settings: &RunSettings,
     label: &str,
     make: F,
-) -> Result<Vec<(ChainOutput, K)>, AppError>
+) -> Result<Vec<(ChainOutput, K)>, Error>
 where
     P: Fittable,
     K: Kernel<Counted<P>> + Send,
@@ -352,7 +352,7 @@ where
         Some(n) => rayon::ThreadPoolBuilder::new()
             .num_threads(n)
             .build()
-            .map_err(|e| AppError::Usage(format!("--threads {n}: {e}")))?
+            .map_err(|e| Error::setting("threads", n, e.to_string()))?
             .install(work),
         None => work(),
     };
@@ -424,7 +424,7 @@ pub fn run_sampler<P: Fittable>(
     posterior: &mut P,
     settings: &RunSettings,
     label: &str,
-) -> Result<RunOutput, AppError> {
+) -> Result<RunOutput, Error> {
     settings.validate()?;
     let started = Instant::now();
     let map_watch = Stopwatch::start();
@@ -458,7 +458,7 @@ fn dispatch<P: Fittable>(
     inits: &[Vec<f64>],
     settings: &RunSettings,
     label: &str,
-) -> Result<Vec<ChainOutput>, AppError> {
+) -> Result<Vec<ChainOutput>, Error> {
     let fatal = DensityError::fatal;
     match settings.sampler {
         SamplerKind::Metropolis => Ok(outputs(execute(posterior, inits, settings, label, |_| {
@@ -524,7 +524,7 @@ fn hamiltonian<P, K, B>(
     settings: &RunSettings,
     label: &str,
     build: B,
-) -> Result<Vec<ChainOutput>, AppError>
+) -> Result<Vec<ChainOutput>, Error>
 where
     P: Fittable,
     K: Kernel<Counted<P>> + HamiltonianKernel + Send,
@@ -627,22 +627,18 @@ impl<K: HamiltonianKernel> Adaptation<K> for HamiltonianAdaptation {
     }
 }
 
-fn load_adaptation(settings: &RunSettings) -> Result<Option<AdaptationState>, AppError> {
+fn load_adaptation(settings: &RunSettings) -> Result<Option<AdaptationState>, Error> {
     let Some(path) = &settings.load_adaptation else {
         return Ok(None);
     };
-    let text = std::fs::read_to_string(path).map_err(|e| {
-        AppError::Input(crate::io::InputError::new(
-            path,
-            format!("cannot read: {e}"),
-        ))
-    })?;
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| Error::Input(InputError::new(path, format!("cannot read: {e}"))))?;
     AdaptationState::from_toml(&text)
         .map(Some)
-        .map_err(|e| AppError::Input(crate::io::InputError::new(path, e)))
+        .map_err(|e| Error::Input(InputError::new(path, e)))
 }
 
-fn save_adaptation(settings: &RunSettings, state: Option<AdaptationState>) -> Result<(), AppError> {
+fn save_adaptation(settings: &RunSettings, state: Option<AdaptationState>) -> Result<(), Error> {
     if let (Some(path), Some(state)) = (&settings.save_adaptation, state) {
         crate::io::write_atomically(path, state.to_toml().as_bytes())?;
     }
@@ -655,7 +651,7 @@ pub fn write_draws(
     prefix: &str,
     run: &RunOutput,
     metadata: &[(String, String)],
-) -> Result<Vec<PathBuf>, AppError> {
+) -> Result<Vec<PathBuf>, Error> {
     let mut paths = Vec::new();
     for chain in &run.chains {
         let path = dir.join(format!(
