@@ -23,10 +23,10 @@ use std::hint::black_box;
 use criterion::{Criterion, criterion_group, criterion_main};
 use nalgebra::DMatrix;
 
-use motorcal::app::problem::Problem;
-use motorcal::app::run::map_estimate;
 use motorcal::bayes::{CalibrationPosterior, ModelSettings};
 use motorcal::density::{FisherMetric, LogDensity};
+use motorcal::pipeline::map_estimate;
+use motorcal::study::Problem;
 use motorcal::synthetic::DEFAULT_SEED;
 
 const DEGREES: [usize; 3] = [0, 9, 20];

@@ -31,10 +31,10 @@ use std::time::Duration;
 
 use criterion::{Criterion, SamplingMode, criterion_group, criterion_main};
 
-use motorcal::app::problem::Problem;
-use motorcal::app::run::{RunOutput, RunSettings, SamplerKind, run_sampler};
 use motorcal::bayes::ModelSettings;
+use motorcal::pipeline::{RunOutput, RunSettings, SamplerKind, run_sampler};
 use motorcal::sampler::ChainSettings;
+use motorcal::study::Problem;
 use motorcal::synthetic::DEFAULT_SEED;
 
 const DEGREES: [usize; 3] = [0, 9, 20];

@@ -12,11 +12,10 @@ use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 
-use motorcal::app::diagnose::problem_with;
-use motorcal::app::problem::Problem;
 use motorcal::bayes::{CalibrationPosterior, ModelSettings};
 use motorcal::density::LogDensity;
 use motorcal::motor::Term;
+use motorcal::study::Problem;
 use motorcal::synthetic::DEFAULT_SEED;
 
 fn posterior(terms: &[&str]) -> (CalibrationPosterior, Vec<f64>) {
@@ -25,7 +24,7 @@ fn posterior(terms: &[&str]) -> (CalibrationPosterior, Vec<f64>) {
         // The terms on at their defaults and calibrated with R, as diagnose builds a candidate
         // (its BM1 setting is not used: the posterior below is BM2(9)).
         let names: Vec<String> = terms.iter().map(|t| t.to_string()).collect();
-        problem = problem_with(&problem, &names).expect("known terms");
+        problem = problem.with_terms(&names).expect("known terms");
     }
     let mut posterior = problem
         .posterior(&ModelSettings::bm2(9))

@@ -15,10 +15,9 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use nalgebra::DMatrix;
 use rand_chacha::ChaCha8Rng;
 
-use motorcal::app::problem::Problem;
-use motorcal::app::run::map_estimate;
 use motorcal::bayes::{CalibrationPosterior, ModelSettings};
 use motorcal::density::{Counted, LogDensity};
+use motorcal::pipeline::map_estimate;
 use motorcal::sampler::adapt::WindowedAdaptation;
 use motorcal::sampler::adaptive_metropolis::{AdaptiveMetropolis, HaarioAdaptation};
 use motorcal::sampler::driver::chain_rng;
@@ -29,6 +28,7 @@ use motorcal::sampler::metric::{Metric, MetricKind};
 use motorcal::sampler::metropolis::{Metropolis, PyMc3Tuning};
 use motorcal::sampler::nuts::{Nuts, NutsSettings};
 use motorcal::sampler::{Adaptation, ChainSettings, Kernel, State, run_chain};
+use motorcal::study::Problem;
 use motorcal::synthetic::DEFAULT_SEED;
 
 const K: usize = 9;

@@ -13,12 +13,12 @@ use std::path::{Path, PathBuf};
 use rayon::prelude::*;
 use serde::Serialize;
 
-use motorcal::app::cases::{CaseOptions, make_case};
-use motorcal::app::diagnose::{DiagnoseOptions, diagnose};
-use motorcal::app::simulate::InputProfile;
+use motorcal::discover::{DiscoverSettings, discover};
 use motorcal::motor::Term;
 use motorcal::pipeline::{RunSettings, SamplerKind};
 use motorcal::sampler::ChainSettings;
+use motorcal::study::cases::{Case, CaseOptions, make_case};
+use motorcal::study::{InputProfile, Problem};
 
 #[derive(Clone, Debug, Serialize)]
 struct Row {
@@ -55,27 +55,29 @@ fn run_settings() -> RunSettings {
             keep: None,
         },
         quiet: true,
-        metric_adaptation: motorcal::app::diagnose::METRIC_ADAPTATION,
+        metric_adaptation: motorcal::discover::METRIC_ADAPTATION,
         ..RunSettings::default()
     }
 }
 
-fn diagnose_dir(dir: &Path, rank_only: bool) -> motorcal::app::diagnose::Diagnosis {
-    diagnose(&DiagnoseOptions {
-        data: vec![dir.join("recording.csv")],
-        model: dir.join("motor.toml"),
-        k: None,
-        candidates: None,
+/// The case diagnosed in memory, as `diagnose` would from its files.
+fn diagnose_case(name: &str, case: &Case, rank_only: bool) -> motorcal::discover::Diagnosis {
+    let problem = Problem {
+        label: name.to_string(),
+        recordings: vec![case.recording.clone()],
+        model: case.nominal.clone(),
+        reference: None,
+    };
+    let settings = DiscoverSettings {
         run: run_settings(),
-        out: None,
-        json: None,
         rank_only,
-    })
-    .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        ..DiscoverSettings::default()
+    };
+    discover(&problem, &settings).unwrap_or_else(|e| panic!("{name}: {e}"))
 }
 
 /// Right: one effect named (or tied); none for a null case; both of two in the selected set.
-fn judge(truth: &[String], d: &motorcal::app::diagnose::Diagnosis) -> bool {
+fn judge(truth: &[String], d: &motorcal::discover::Diagnosis) -> bool {
     match truth.len() {
         0 => d.selected == "none",
         1 => d.selected == truth[0] || d.ties.contains(&truth[0]),
@@ -91,7 +93,6 @@ fn main() {
     let seed_base: u64 = arg(&args, "--seed-base", 900_000);
     let out = PathBuf::from(arg(&args, "--out", "papers/diagnose".to_string()));
     let full = args.iter().any(|a| a == "--full");
-    let scratch = std::env::temp_dir().join(format!("motorcal-study-{}", std::process::id()));
 
     // Case specifications: (set, effects, seed, first input).
     let mut specs: Vec<(String, Vec<String>, u64, InputProfile)> = Vec::new();
@@ -126,23 +127,23 @@ fn main() {
     }
 
     let make = |effects: &[String], seed: u64, input: InputProfile| {
-        let dir = scratch.join(format!("{}-{seed}", effects.join("+")));
-        let answer = make_case(&CaseOptions {
+        let name = format!("{}-{seed}", effects.join("+"));
+        let case = make_case(&CaseOptions {
             effects: effects.to_vec(),
             magnitude: None,
             input,
             seed,
             conceal: true,
-            out: dir.clone(),
         });
-        (dir, answer)
+        (name, case)
     };
-    let evaluate = |set: &str, dir: &Path, answer: &motorcal::app::cases::Answer| {
-        let d = diagnose_dir(dir, !full);
+    let evaluate = |set: &str, name: &str, case: &Case| {
+        let d = diagnose_case(name, case, !full);
+        let answer = &case.answer;
         let truth = answer.effects.clone();
         let row = Row {
             set: set.into(),
-            case: dir.file_name().unwrap().to_string_lossy().into_owned(),
+            case: name.to_string(),
             right: judge(&truth, &d),
             truth,
             seed: answer.seed,
@@ -172,9 +173,9 @@ fn main() {
     let mut rows: Vec<Row> = specs
         .par_iter()
         .filter_map(|(set, effects, seed, input)| {
-            let (dir, answer) = make(effects, *seed, *input);
-            match answer {
-                Ok(a) => Some(evaluate(set, &dir, &a)),
+            let (name, case) = make(effects, *seed, *input);
+            match case {
+                Ok(c) => Some(evaluate(set, &name, &c)),
                 Err(e) => {
                     eprintln!("{set} {effects:?} seed {seed}: not made: {e}");
                     None
@@ -191,9 +192,9 @@ fn main() {
             .par_iter()
             .filter_map(|(a, b, seed)| {
                 let effects = vec![a.to_string(), b.to_string()];
-                let (dir, answer) = make(&effects, *seed, InputProfile::Reversal);
-                match answer {
-                    Ok(ans) => Some(evaluate("two", &dir, &ans)),
+                let (name, case) = make(&effects, *seed, InputProfile::Reversal);
+                match case {
+                    Ok(c) => Some(evaluate("two", &name, &c)),
                     Err(e) => {
                         eprintln!("two {effects:?} seed {seed}: not made: {e}");
                         None
@@ -219,7 +220,15 @@ fn main() {
             } else {
                 vec![effect]
             };
-            let d = diagnose_dir(&dir, false);
+            let problem =
+                Problem::from_files(&[dir.join("recording.csv")], &dir.join("motor.toml"))
+                    .unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
+            let settings = DiscoverSettings {
+                run: run_settings(),
+                ..DiscoverSettings::default()
+            };
+            let d =
+                discover(&problem, &settings).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
             let row = Row {
                 set: "dev".into(),
                 case: format!("case{i:02}"),
@@ -331,5 +340,4 @@ fn main() {
             );
         }
     }
-    let _ = std::fs::remove_dir_all(&scratch);
 }

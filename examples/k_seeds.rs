@@ -9,12 +9,12 @@ use std::path::PathBuf;
 
 use serde::Serialize;
 
-use motorcal::app::problem::Problem;
-use motorcal::app::sweep::select::{evidence, sigma_stabilisation};
-use motorcal::app::sweep::{SweepOptions, SweepRecord, run_k};
 use motorcal::bayes::{CoefficientPrior, ModelSettings};
+use motorcal::paper::sweep::select::{evidence, sigma_stabilisation};
+use motorcal::paper::sweep::{SweepOptions, SweepRecord, run_k};
 use motorcal::pipeline::{MetricAdaptation, RunSettings, SamplerKind, run_sampler};
 use motorcal::sampler::ChainSettings;
+use motorcal::study::Problem;
 
 #[derive(Serialize)]
 struct SeedRow {
@@ -86,7 +86,12 @@ fn main() {
         let records: Vec<SweepRecord> = options
             .ks
             .iter()
-            .map(|&k| run_k(&problem, data_seed, k, &options).expect("a K runs"))
+            .map(|&k| {
+                run_k(&problem, data_seed, k, &options, &mut |_| {
+                    Ok::<_, motorcal::error::Error>(())
+                })
+                .expect("a K runs")
+            })
             .collect();
         let k_sigma = sigma_stabilisation(&records).k;
         let k_evidence = evidence(&records).k;

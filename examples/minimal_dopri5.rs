@@ -14,9 +14,9 @@
 #![allow(clippy::needless_range_loop)]
 use std::time::Instant;
 
-use motorcal::app::problem::Problem;
 use motorcal::bayes::ModelSettings;
 use motorcal::density::LogDensity;
+use motorcal::study::Problem;
 use num_dual::{Dual64, DualNum};
 
 // The right-hand side is autonomous (constant voltage): the nodes c_i are not needed.

@@ -2,9 +2,9 @@
 //! `benches/` are the measurement of record).
 use std::time::Instant;
 
-use motorcal::app::problem::Problem;
 use motorcal::bayes::ModelSettings;
 use motorcal::density::LogDensity;
+use motorcal::study::Problem;
 
 fn main() {
     let problem = Problem::paper(1).unwrap();

@@ -23,9 +23,10 @@ pub enum Error {
 impl Error {
     /// A setting `name` whose value cannot be used, and why.
     pub fn setting(name: &str, value: impl fmt::Display, message: impl Into<String>) -> Self {
+        let value = value.to_string();
         Error::Settings(SettingError {
             name: name.into(),
-            value: Some(value.to_string()),
+            value: (!value.is_empty()).then_some(value),
             message: message.into(),
         })
     }

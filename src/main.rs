@@ -632,7 +632,7 @@ fn table1(args: Table1Args) -> Result<(), AppError> {
 }
 
 fn run_table1(options: app::table1::Table1Options) -> Result<(), AppError> {
-    let report = app::table1::reproduce_table1(&options)?;
+    let report = app::table1::table1(&options)?;
     print!("{}", app::table1::format_report(&report));
     println!();
     println!(
@@ -673,14 +673,16 @@ fn run(cli: Cli) -> Result<(), AppError> {
             conceal,
         }) => {
             if let Some(effects) = effect {
-                let answer = app::cases::make_case(&app::cases::CaseOptions {
-                    effects,
-                    magnitude,
-                    input,
-                    seed,
-                    conceal,
-                    out: out.clone(),
-                })?;
+                let answer = app::cases::write_case(
+                    &motorcal::study::cases::CaseOptions {
+                        effects,
+                        magnitude,
+                        input,
+                        seed,
+                        conceal,
+                    },
+                    &out,
+                )?;
                 println!(
                     "wrote {} (effect {}, peak {:.2}/{:.2} σ on I/ω, input {:?}{})",
                     out.display(),

@@ -25,10 +25,10 @@
 
 use std::time::Instant;
 
-use motorcal::app::problem::Problem;
-use motorcal::app::run::{RunOutput, RunSettings, SamplerKind, run_sampler};
 use motorcal::bayes::{CalibrationPosterior, ModelSettings};
+use motorcal::pipeline::{RunOutput, RunSettings, SamplerKind, run_sampler};
 use motorcal::sampler::ChainSettings;
+use motorcal::study::Problem;
 use motorcal::synthetic::DEFAULT_SEED;
 
 /// Seed of the reference chains. Different from `SAMPLER_SEED`, so that the NUTS-dense run

@@ -3,8 +3,8 @@
 //! within its Monte Carlo error; where a parameter piles against its bound it stays finite and
 //! its weights usable.
 
-use motorcal::app::diagnose::{fit_candidate, importance_evidence};
-use motorcal::app::problem::Problem;
+use motorcal::discover::{fit_candidate, importance_evidence};
+use motorcal::study::Problem;
 
 #[test]
 fn importance_sampling_agrees_with_laplace_where_the_posterior_is_gaussian() {
@@ -12,7 +12,7 @@ fn importance_sampling_agrees_with_laplace_where_the_posterior_is_gaussian() {
     // The paper's data were made with c_g = 0.01 and the model says 0.009: the torque-constant
     // term is strongly identified, its posterior nearly Gaussian.
     let fit = fit_candidate(&problem, &["torque_constant".to_string()]).unwrap();
-    let c = importance_evidence(&problem, &fit, 7).unwrap();
+    let c = importance_evidence(&fit, 7).unwrap();
     eprintln!("{c:?}");
     assert!(c.effective_draws > 500.0, "{c:?}");
     let gap = c.log_evidence - c.log_evidence_laplace;
@@ -34,7 +34,7 @@ fn a_parameter_at_its_bound_is_flagged_and_still_estimated() {
     let fit = fit_candidate(&problem, &["coulomb_friction".to_string()]).unwrap();
     eprintln!("at bound: {:?}", fit.at_bound);
     assert_eq!(fit.at_bound, vec!["coulomb_friction.T_c".to_string()]);
-    let c = importance_evidence(&problem, &fit, 7).unwrap();
+    let c = importance_evidence(&fit, 7).unwrap();
     eprintln!("{c:?}");
     assert!(
         c.log_evidence.is_finite() && c.effective_draws > 50.0,

@@ -5,7 +5,8 @@
 
 use std::path::{Path, PathBuf};
 
-use motorcal::app::diagnose::{DiagnoseOptions, Diagnosis, diagnose};
+use motorcal::app::diagnose::{DiagnoseOptions, diagnose};
+use motorcal::discover::Diagnosis;
 use motorcal::pipeline::RunSettings;
 
 fn dev_dir() -> Option<PathBuf> {
@@ -37,7 +38,7 @@ fn run(case: &Path, rank_only: bool) -> Diagnosis {
                 draws: 400,
                 keep: None,
             },
-            metric_adaptation: motorcal::app::diagnose::METRIC_ADAPTATION,
+            metric_adaptation: motorcal::discover::METRIC_ADAPTATION,
             ..RunSettings::default()
         },
         out: None,

@@ -6,9 +6,10 @@
 
 use std::path::PathBuf;
 
-use motorcal::app::diagnose::{DiagnoseOptions, Diagnosis, diagnose};
-use motorcal::app::run::{RunSettings, SamplerKind};
+use motorcal::app::diagnose::{DiagnoseOptions, diagnose};
 use motorcal::app::simulate::{InputProfile, SimulateOptions, simulate};
+use motorcal::discover::Diagnosis;
+use motorcal::pipeline::{RunSettings, SamplerKind};
 use motorcal::synthetic::sample_times;
 
 /// The development set's nominal motor (§2.1).

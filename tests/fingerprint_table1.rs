@@ -6,10 +6,10 @@
 //! them; their Laplace-metric warm-up (the default since) is pinned from the commit that
 //! added it.
 
-use motorcal::app::problem::Problem;
-use motorcal::app::run::{MetricAdaptation, RunSettings, SamplerKind, run_sampler};
 use motorcal::bayes::ModelSettings;
+use motorcal::pipeline::{MetricAdaptation, RunSettings, SamplerKind, run_sampler};
 use motorcal::sampler::ChainSettings;
+use motorcal::study::Problem;
 
 /// FNV-1a over the bits of every draw of every chain, in order.
 fn fingerprint(samplers: &[SamplerKind], settings: &ModelSettings) -> u64 {

@@ -2,15 +2,15 @@
 //! else, the draws do not depend on the thread count, and the short default warm-up keeps
 //! R-hat and ESS on BM2 where Stan's windows needed 1000 iterations.
 
-use motorcal::app::problem::Problem;
-use motorcal::app::run::{
+use motorcal::bayes::ModelSettings;
+use motorcal::pipeline::{
     LAPLACE_WARMUP, MetricAdaptation, RunSettings, SamplerKind, default_warmup, map_estimate,
     run_sampler,
 };
-use motorcal::bayes::ModelSettings;
 use motorcal::sampler::ChainSettings;
 use motorcal::sampler::adapt::AdaptationState;
 use motorcal::sampler::metric::{Metric, MetricKind};
+use motorcal::study::Problem;
 
 fn settings(sampler: SamplerKind, warmup: usize, draws: usize) -> RunSettings {
     RunSettings {

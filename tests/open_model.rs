@@ -422,10 +422,10 @@ fn all_terms_at_once_simulate_and_find_a_map() {
 
 #[test]
 fn the_laplace_evidence_does_not_depend_on_the_coordinate_r_is_sampled_in() {
-    use motorcal::app::problem::Problem;
     use motorcal::bayes::ModelSettings;
     use motorcal::io::CalibrateEntry;
     use motorcal::pipeline::map_estimate;
+    use motorcal::study::Problem;
     // The paper's R prior N(0.1, 0.02) sampled as R itself (schema 1) and through log R
     // ([calibrate]): the same density up to a truncation at R < 0 of 5σ, so the same evidence
     // once the log-Jacobian is counted. R's posterior is narrow (sd ~1e-4), where log R is

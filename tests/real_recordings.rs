@@ -9,11 +9,12 @@ use std::process::Command;
 
 use nalgebra::DMatrix;
 
-use motorcal::app::diagnose::{DiagnoseOptions, diagnose, records_reverse};
+use motorcal::app::diagnose::{DiagnoseOptions, diagnose};
 use motorcal::app::predict::{PredictOptions, predict};
-use motorcal::app::problem::Problem;
-use motorcal::app::run::{RunSettings, SamplerKind};
+use motorcal::discover::records_reverse;
 use motorcal::ode::SolverSettings;
+use motorcal::pipeline::{RunSettings, SamplerKind};
+use motorcal::study::Problem;
 
 fn real_dir() -> Option<PathBuf> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/real");

@@ -29,12 +29,12 @@
 
 use std::time::Instant;
 
-use motorcal::app::run::{RunSettings, SamplerKind, run_sampler};
 use motorcal::bayes::{CalibrationPosterior, ModelSettings, Observations, Prior, ln_gamma};
 use motorcal::diagnostics::ess_bulk;
 use motorcal::forward::ForwardModel;
 use motorcal::motor::{MotorModel, MotorParameters, VoltageInput};
 use motorcal::ode::SolverSettings;
+use motorcal::pipeline::{RunSettings, SamplerKind, run_sampler};
 use motorcal::sampler::ChainSettings;
 use motorcal::sampler::driver::chain_rng;
 use motorcal::synthetic::{generate, sample_times};

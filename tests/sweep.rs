@@ -2,9 +2,9 @@
 //! measures, and `select-k`'s σ rule sees that K = 0 has not stabilised (the discrepancy is
 //! not yet captured, so the noise σ is overestimated, §4.2).
 
-use motorcal::app::sweep::select::{TOLERANCE, evidence, sigma_stabilisation, wasserstein_1};
 use motorcal::app::sweep::{SweepOptions, merge, sweep, write_outputs};
 use motorcal::bayes::CoefficientPrior;
+use motorcal::paper::sweep::select::{TOLERANCE, evidence, sigma_stabilisation, wasserstein_1};
 use motorcal::pipeline::{RunSettings, SamplerKind};
 use motorcal::sampler::ChainSettings;
 

@@ -11,11 +11,11 @@ use crate::sampler::ChainSettings;
 use crate::synthetic::DEFAULT_SEED;
 
 use super::AppError;
-use super::problem::Problem;
 use super::run::{
     MetricAdaptation, RunCost, RunOutput, RunSettings, SamplerKind, default_warmup, ratio_2sf,
     run_sampler,
 };
+use crate::study::Problem;
 
 /// The K values of the study unless told otherwise.
 pub const DEFAULT_KS: [usize; 7] = [0, 3, 6, 9, 12, 15, 20];

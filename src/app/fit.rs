@@ -7,10 +7,13 @@ use serde::Serialize;
 use crate::bayes::{CalibrationPosterior, ModelSettings};
 use crate::density::LogDensity;
 use crate::diagnostics::ParameterSummary;
-use crate::pipeline::{RunOutput, RunSettings, map_estimate, run_sampler, write_draws};
+use crate::pipeline::{
+    RunOutput, RunSettings, map_estimate, posterior_mean, run_sampler, write_draws,
+};
 
-use super::problem::Problem;
-use super::{AppError, predictive, provenance};
+use super::figures::{plot_discrepancy, plot_predictive, plot_traces, write_predictive_csv};
+use super::{AppError, provenance};
+use crate::study::{Problem, posterior_predictive};
 
 #[derive(Clone, Debug)]
 pub struct FitOptions {
@@ -160,23 +163,6 @@ pub fn fit(options: &FitOptions) -> Result<FitReport, AppError> {
     Ok(report)
 }
 
-/// The mean of every chain's unconstrained draws.
-pub fn posterior_mean(run: &RunOutput) -> Vec<f64> {
-    let all: Vec<&Vec<f64>> = run
-        .chains
-        .iter()
-        .flat_map(|c| c.unconstrained.iter())
-        .collect();
-    let d = all.first().map_or(0, |x| x.len());
-    let mut mean = vec![0.0; d];
-    for x in &all {
-        for (m, v) in mean.iter_mut().zip(x.iter()) {
-            *m += v / all.len() as f64;
-        }
-    }
-    mean
-}
-
 /// RMSE and σ of every recording's channels at x.
 pub fn channel_fits(
     posterior: &mut CalibrationPosterior,
@@ -227,9 +213,9 @@ fn write_run_outputs(
         } else {
             String::new()
         };
-        let p = predictive::posterior_predictive(posterior, &run.chains, r)?;
+        let p = posterior_predictive(posterior, &run.chains, r)?;
         let csv = options.out.join(format!("predictive{suffix}.csv"));
-        predictive::write_predictive_csv(&csv, &p)?;
+        write_predictive_csv(&csv, &p)?;
         let png = options.out.join(format!("predictive{suffix}.png"));
         let title = format!(
             "{} — {} on {}",
@@ -237,13 +223,13 @@ fn write_run_outputs(
             run.sampler,
             posterior.record_label(r)
         );
-        predictive::plot_predictive(&png, &title, &p)?;
+        plot_predictive(&png, &title, &p)?;
         report
             .outputs
             .extend([&csv, &png].iter().map(|p| p.display().to_string()));
         if settings.discrepancy_degree.is_some() {
             let png = options.out.join(format!("discrepancy{suffix}.png"));
-            predictive::plot_discrepancy(&png, &format!("δ of {title}"), &p, None)?;
+            plot_discrepancy(&png, &format!("δ of {title}"), &p, None)?;
             report.outputs.push(png.display().to_string());
         }
     }
@@ -255,7 +241,7 @@ fn write_run_outputs(
         .take(3)
         .map(|s| (s.name.as_str(), None))
         .collect();
-    predictive::plot_traces(&traces, &title, &run.chains, &shown)?;
+    plot_traces(&traces, &title, &run.chains, &shown)?;
     report.outputs.push(traces.display().to_string());
     Ok(())
 }

@@ -4,10 +4,9 @@
 pub mod bench;
 pub mod cases;
 pub mod diagnose;
+pub mod figures;
 pub mod fit;
 pub mod predict;
-pub mod predictive;
-pub mod problem;
 /// The fit pipeline, where the commands have always found it.
 pub use crate::pipeline as run;
 pub mod simulate;
@@ -88,10 +87,4 @@ impl From<std::io::Error> for AppError {
     }
 }
 
-/// Provenance written into every output: crate version and the commit it was built from.
-pub fn provenance() -> Vec<(String, String)> {
-    vec![
-        ("motorcal_version".into(), env!("CARGO_PKG_VERSION").into()),
-        ("git_commit".into(), env!("MOTORCAL_GIT_COMMIT").into()),
-    ]
-}
+pub use crate::io::provenance;

@@ -3,60 +3,23 @@
 
 use std::path::PathBuf;
 
-use serde::{Deserialize, Serialize};
-
 use crate::io::{ModelFile, read_model_file, write_model_file, write_recording};
 use crate::motor::{MotorParameters, VoltageInput};
+pub use crate::study::InputProfile;
+
+/// The command line names the profiles as the model files and reports do.
+impl clap::ValueEnum for InputProfile {
+    fn value_variants<'a>() -> &'a [Self] {
+        &InputProfile::ALL
+    }
+
+    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
+        Some(clap::builder::PossibleValue::new(self.name()).help(self.help()))
+    }
+}
 use crate::synthetic::{DEFAULT_SEED, generate, sample_times};
 
 use super::AppError;
-
-/// The voltage the motor is driven with.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
-#[serde(rename_all = "snake_case")]
-pub enum InputProfile {
-    /// The model's constant U (the paper's start-up).
-    #[default]
-    Constant,
-    /// U, then U/3 from 40% of the record: the speed falls back, so friction and inertia act
-    /// with the opposite sign of the current's change.
-    Step,
-    /// U, then U/3 from 20%, then −U from 60%: the speed changes sign, which separates Coulomb
-    /// friction from a constant load.
-    Reversal,
-}
-
-impl InputProfile {
-    pub fn voltage(&self, u: f64, times: &[f64]) -> VoltageInput {
-        let t_end = times.last().copied().unwrap_or(0.0);
-        let level = |t: f64| match self {
-            InputProfile::Constant => u,
-            InputProfile::Step => {
-                if t < 0.4 * t_end {
-                    u
-                } else {
-                    u / 3.0
-                }
-            }
-            InputProfile::Reversal => {
-                if t < 0.2 * t_end {
-                    u
-                } else if t < 0.6 * t_end {
-                    u / 3.0
-                } else {
-                    -u
-                }
-            }
-        };
-        match self {
-            InputProfile::Constant => VoltageInput::Constant,
-            _ => VoltageInput::Held {
-                times: times.to_vec(),
-                values: times.iter().map(|&t| level(t)).collect(),
-            },
-        }
-    }
-}
 
 /// Options of `motorcal simulate`.
 #[derive(Clone, Debug)]
@@ -144,7 +107,7 @@ pub fn simulate(options: &SimulateOptions) -> Result<SimulateReport, AppError> {
         VoltageInput::Held { values, .. } => Some(values),
         VoltageInput::Constant => None,
     };
-    let recording = super::problem::recording_from(&data, "motorcal simulate", voltage);
+    let recording = crate::study::recording_from(&data, "motorcal simulate", voltage);
     let report = SimulateReport {
         recording: options.out.join("recording.csv"),
         nominal: options.out.join("motor.toml"),

@@ -25,3 +25,11 @@ pub use model_file::{
 };
 pub use model_tables::{CalibrateEntry, DiscrepancyChoice};
 pub use recording::{ChannelMap, Recording, read_recording, read_recording_for, write_recording};
+
+/// Provenance written into every output: crate version and the commit it was built from.
+pub fn provenance() -> Vec<(String, String)> {
+    vec![
+        ("motorcal_version".into(), env!("CARGO_PKG_VERSION").into()),
+        ("git_commit".into(), env!("MOTORCAL_GIT_COMMIT").into()),
+    ]
+}

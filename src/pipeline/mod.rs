@@ -680,3 +680,20 @@ pub fn write_draws(
     }
     Ok(paths)
 }
+
+/// The mean of every chain's unconstrained draws.
+pub fn posterior_mean(run: &RunOutput) -> Vec<f64> {
+    let all: Vec<&Vec<f64>> = run
+        .chains
+        .iter()
+        .flat_map(|c| c.unconstrained.iter())
+        .collect();
+    let d = all.first().map_or(0, |x| x.len());
+    let mut mean = vec![0.0; d];
+    for x in &all {
+        for (m, v) in mean.iter_mut().zip(x.iter()) {
+            *m += v / all.len() as f64;
+        }
+    }
+    mean
+}

@@ -10,21 +10,19 @@
 pub mod oracle;
 
 use std::collections::BTreeMap;
-use std::path::PathBuf;
 
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 use serde::Serialize;
 
-use crate::app::AppError;
-use crate::app::diagnose::problem_with;
-use crate::app::problem::Problem;
-use crate::app::simulate::InputProfile;
-use crate::io::{ModelFile, Recording, write_model_file, write_recording};
+use crate::error::Error;
+use crate::io::{ModelFile, Recording};
 use crate::motor::{MotorParam, Term, VoltageInput};
 use crate::ode::SolverSettings;
 use crate::parameter::Support;
+use crate::study::InputProfile;
+use crate::study::Problem;
 use crate::synthetic::sample_times;
 
 use oracle::{NONE_MARGIN, RUNNER_UP_MARGIN, least_squares};
@@ -46,7 +44,15 @@ pub struct CaseOptions {
     pub input: InputProfile,
     pub seed: u64,
     pub conceal: bool,
-    pub out: PathBuf,
+}
+
+/// A concealed-physics case: the noisy recording, the nominal model a user would believe (the
+/// paper's motor with its defaults), and the answer.
+#[derive(Clone, Debug)]
+pub struct Case {
+    pub recording: Recording,
+    pub nominal: ModelFile,
+    pub answer: Answer,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -100,9 +106,9 @@ fn truth_output(
     base: &Problem,
     r_true: f64,
     effects: &[(String, Vec<f64>)],
-) -> Result<Vec<f64>, AppError> {
+) -> Result<Vec<f64>, Error> {
     let names: Vec<String> = effects.iter().map(|(n, _)| n.clone()).collect();
-    let mut problem = problem_with(base, &names)?;
+    let mut problem = base.with_terms(&names)?;
     problem.model.motor.set(MotorParam::Resistance, r_true);
     for (name, values) in effects {
         if let Some(t) = problem
@@ -119,21 +125,21 @@ fn truth_output(
     let mut out = vec![0.0; forward.n_outputs()];
     forward
         .simulate(&[], &mut out)
-        .map_err(|e| AppError::Numerical(e.to_string()))?;
+        .map_err(|e| Error::Numerical(e.to_string()))?;
     Ok(out)
 }
 
 /// Peak |truth − best nominal| / σ per channel, and the refitted R.
-fn peak_over_sigma(base: &Problem, truth: &[f64]) -> Result<([f64; 2], f64), AppError> {
+fn peak_over_sigma(base: &Problem, truth: &[f64]) -> Result<([f64; 2], f64), Error> {
     let (_, theta) = least_squares(base, &[], truth, &NOISE_SD)?;
-    let mut problem = problem_with(base, &[])?;
+    let mut problem = base.with_terms(&[])?;
     problem.model.calibrate = Some(Vec::new());
     problem.model.motor.set(MotorParam::Resistance, theta[0]);
     let forward = problem.forward(SolverSettings::default())?;
     let mut out = vec![0.0; forward.n_outputs()];
     forward
         .simulate(&[], &mut out)
-        .map_err(|e| AppError::Numerical(e.to_string()))?;
+        .map_err(|e| Error::Numerical(e.to_string()))?;
     let m = SAMPLES;
     let mut peak = [0.0f64; 2];
     for c in 0..2 {
@@ -161,8 +167,8 @@ fn scale_effect(
     drawn: &[f64],
     sign: f64,
     target: f64,
-) -> Result<f64, AppError> {
-    let peak = |size: f64| -> Result<f64, AppError> {
+) -> Result<f64, Error> {
+    let peak = |size: f64| -> Result<f64, Error> {
         let truth = truth_output(
             base,
             r_true,
@@ -199,10 +205,10 @@ fn oracle_margins(
     base: &Problem,
     truth: &[f64],
     effects: &[String],
-) -> Result<(f64, String, f64), AppError> {
+) -> Result<(f64, String, f64), Error> {
     let n = (2 * SAMPLES) as f64;
-    let score = |added: &[String]| -> Result<f64, AppError> {
-        let problem = problem_with(base, added)?;
+    let score = |added: &[String]| -> Result<f64, Error> {
+        let problem = base.with_terms(added)?;
         let d = problem.calibrated_names()?.len() as f64 - 1.0;
         let (ss, _) = least_squares(base, added, truth, &NOISE_SD)?;
         Ok(-0.5 * ss - 0.5 * d * n.ln())
@@ -237,7 +243,7 @@ fn oracle_margins(
     Ok((own - runner_up.1, runner_up.0, own - none))
 }
 
-pub fn make_case(options: &CaseOptions) -> Result<Answer, AppError> {
+pub fn make_case(options: &CaseOptions) -> Result<Case, Error> {
     let effects: Vec<String> = options
         .effects
         .iter()
@@ -246,29 +252,37 @@ pub fn make_case(options: &CaseOptions) -> Result<Answer, AppError> {
         .collect();
     for e in &effects {
         if Term::named(e).is_none() {
-            return Err(AppError::Usage(format!(
-                "--effect: unknown effect '{e}' (known: none, {})",
-                Term::NAMES.join(", ")
-            )));
+            return Err(Error::setting(
+                "effect",
+                "",
+                format!(
+                    "unknown effect '{e}' (known: none, {})",
+                    Term::NAMES.join(", ")
+                ),
+            ));
         }
     }
     if effects.len() > 2 {
-        return Err(AppError::Usage("--effect: at most two effects".into()));
+        return Err(Error::setting("effect", "", "at most two effects"));
     }
     if let Some(m) = options.magnitude
         && !(m > 0.0 && m.is_finite())
     {
-        return Err(AppError::Usage(format!(
-            "--magnitude {m}: must be a positive multiple of the noise σ"
-        )));
+        return Err(Error::setting(
+            "magnitude",
+            m,
+            "must be a positive multiple of the noise σ",
+        ));
     }
     if options.conceal
         && let Some(m) = options.magnitude
         && m >= CONCEALED_MAX
     {
-        return Err(AppError::Usage(format!(
-            "--magnitude {m} with --conceal: a concealed effect stays below {CONCEALED_MAX} σ"
-        )));
+        return Err(Error::setting(
+            "magnitude",
+            m,
+            format!("a concealed effect stays below {CONCEALED_MAX} σ"),
+        ));
     }
     let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
     let times = sample_times(DURATION, SAMPLES);
@@ -334,7 +348,7 @@ pub fn make_case(options: &CaseOptions) -> Result<Answer, AppError> {
             if options.conceal && !fair {
                 continue;
             }
-            return write_case(
+            return Ok(assemble_case(
                 options,
                 &base,
                 &voltage,
@@ -350,17 +364,19 @@ pub fn make_case(options: &CaseOptions) -> Result<Answer, AppError> {
                 runner_up,
                 over_none,
                 attempts,
-            );
+            ));
         }
     }
-    Err(AppError::Usage(format!(
-        "--effect {}: not identifiable on any input after {attempts} draws",
-        options.effects.join(",")
-    )))
+    Err(Error::setting(
+        "effect",
+        options.effects.join(","),
+        format!("not identifiable on any input after {attempts} draws"),
+    ))
 }
 
+/// The recording with its noise drawn, and the answer.
 #[allow(clippy::too_many_arguments)]
-fn write_case(
+fn assemble_case(
     options: &CaseOptions,
     base: &Problem,
     voltage: &VoltageInput,
@@ -376,7 +392,7 @@ fn write_case(
     runner_up: Option<String>,
     over_none: Option<f64>,
     attempts: usize,
-) -> Result<Answer, AppError> {
+) -> Case {
     let times = base.recordings[0].time.clone();
     let mut rng = ChaCha8Rng::seed_from_u64(options.seed ^ 0x6e6f_6973_6500);
     let measured: Vec<Vec<f64>> = (0..2)
@@ -451,11 +467,9 @@ fn write_case(
         oracle_margin_over_none: over_none,
         attempts,
     };
-    std::fs::create_dir_all(&options.out)?;
-    write_recording(&options.out.join("recording.csv"), &recording)?;
-    write_model_file(&options.out.join("motor.toml"), &ModelFile::default())?;
-    let text =
-        serde_json::to_string_pretty(&answer).map_err(|e| AppError::Output(e.to_string()))?;
-    crate::io::write_atomically(&options.out.join("answer.json"), text.as_bytes())?;
-    Ok(answer)
+    Case {
+        recording,
+        nominal: ModelFile::default(),
+        answer,
+    }
 }

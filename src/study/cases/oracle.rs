@@ -9,13 +9,13 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use crate::app::AppError;
-use crate::app::problem::Problem;
+use crate::error::Error;
 use crate::ode::SolverSettings;
 use crate::parameter::Support;
+use crate::study::Problem;
 
 // The starts across a switching time's range are diagnose's: a list of fractions, no scoring.
-use crate::app::diagnose::{BOUNDED_STARTS, problem_with};
+use crate::study::BOUNDED_STARTS;
 
 pub const RUNNER_UP_MARGIN: f64 = 3.0;
 pub const NONE_MARGIN: f64 = 5.0;
@@ -27,8 +27,8 @@ pub fn least_squares(
     added: &[String],
     target: &[f64],
     noise_sd: &[f64],
-) -> Result<(f64, Vec<f64>), AppError> {
-    let problem = problem_with(base, added)?;
+) -> Result<(f64, Vec<f64>), Error> {
+    let problem = base.with_terms(added)?;
     let forward = problem.forward(SolverSettings::default())?;
     let specs = forward.calibrated_specs();
     let m = forward.times().len();
@@ -72,7 +72,7 @@ pub fn least_squares(
         }
     }
     if !best.0.is_finite() {
-        return Err(AppError::Numerical(format!(
+        return Err(Error::Numerical(format!(
             "no least-squares fit of {added:?} converged"
         )));
     }
@@ -93,10 +93,10 @@ fn levenberg_marquardt(
     target: &[f64],
     weights: &[f64],
     mut theta: Vec<f64>,
-) -> Result<(f64, Vec<f64>), AppError> {
+) -> Result<(f64, Vec<f64>), Error> {
     let n = forward.n_outputs();
     let d = theta.len();
-    let numerical = |e: crate::ode::OdeError| AppError::Numerical(e.to_string());
+    let numerical = |e: crate::ode::OdeError| Error::Numerical(e.to_string());
     let mut out = vec![0.0; n];
     let mut jac = DMatrix::zeros(n, d);
     forward

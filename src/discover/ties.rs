@@ -6,12 +6,11 @@
 //! with the other input, noise at the fitted σ is added, and both candidates are refitted to
 //! it. The input separates them when the selected one then leads by more than the threshold.
 
-use crate::app::AppError;
-use crate::app::problem::{Problem, recording_from};
-use crate::app::simulate::InputProfile;
+use crate::error::Error;
+use crate::study::{InputProfile, Problem, recording_from};
 use crate::synthetic::generate;
 
-use super::candidates::{CandidateFit, fit_candidate, problem_with};
+use super::candidate::{Candidate, fit_candidate};
 
 /// The inputs tried, in the order a user would rather run them.
 const INPUTS: [InputProfile; 2] = [InputProfile::Reversal, InputProfile::Step];
@@ -19,13 +18,13 @@ const INPUTS: [InputProfile; 2] = [InputProfile::Reversal, InputProfile::Step];
 /// The first input on which `selected` beats `other` by more than `threshold`, if any.
 pub fn separating_input(
     base: &Problem,
-    selected: &CandidateFit,
+    selected: &Candidate,
     other: &str,
     noise_sd: &[f64],
     threshold: f64,
     seed: u64,
-) -> Result<Option<InputProfile>, AppError> {
-    let truth = truth_problem(base, selected)?;
+) -> Result<Option<InputProfile>, Error> {
+    let truth = selected.fitted_problem();
     if base.model.base.is_drive() {
         return reversed_record(base, &truth, selected, other, noise_sd, threshold, seed);
     }
@@ -33,9 +32,9 @@ pub fn separating_input(
         let recording = &base.recordings[0];
         let model_file = &truth.model;
         let voltage = input.voltage(model_file.motor.voltage, &recording.time);
-        let model = model_file.model(voltage.clone()).map_err(AppError::Usage)?;
+        let model = model_file.model(voltage.clone()).map_err(Error::invalid)?;
         let data = generate(&model, &recording.time, noise_sd, seed)
-            .map_err(|e| AppError::Numerical(e.to_string()))?;
+            .map_err(|e| Error::Numerical(e.to_string()))?;
         let values = match &voltage {
             crate::motor::VoltageInput::Held { values, .. } => Some(values.clone()),
             crate::motor::VoltageInput::Constant => None,
@@ -56,12 +55,12 @@ pub fn separating_input(
 fn reversed_record(
     base: &Problem,
     truth: &Problem,
-    selected: &CandidateFit,
+    selected: &Candidate,
     other: &str,
     noise_sd: &[f64],
     threshold: f64,
     seed: u64,
-) -> Result<Option<InputProfile>, AppError> {
+) -> Result<Option<InputProfile>, Error> {
     use rand::SeedableRng;
     use rand_distr::{Distribution, Normal};
 
@@ -82,7 +81,7 @@ fn reversed_record(
         model: truth.model.clone(),
         reference: None,
     };
-    let predicted = crate::app::predict::predict_records(&simulated)?;
+    let predicted = crate::study::predict_records(&simulated)?;
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed ^ 0x7e7e_5eed);
     let mut recording = simulated.recordings[0].clone();
     for ((_, values), (c, (_, _, model))) in recording
@@ -91,7 +90,7 @@ fn reversed_record(
         .zip(predicted[0].channels.iter().enumerate())
     {
         let noise = Normal::new(0.0, noise_sd[c].max(f64::MIN_POSITIVE))
-            .map_err(|e| AppError::Numerical(e.to_string()))?;
+            .map_err(|e| Error::Numerical(e.to_string()))?;
         for (v, g) in values.iter_mut().zip(model) {
             *v = g + noise.sample(&mut rng);
         }
@@ -104,10 +103,10 @@ fn reversed_record(
 fn separates(
     base: &Problem,
     recording: crate::io::Recording,
-    selected: &CandidateFit,
+    selected: &Candidate,
     other: &str,
     threshold: f64,
-) -> Result<bool, AppError> {
+) -> Result<bool, Error> {
     let experiment = Problem {
         label: recording.source.clone(),
         recordings: vec![recording],
@@ -117,14 +116,4 @@ fn separates(
     let a = fit_candidate(&experiment, &selected.added)?;
     let b = fit_candidate(&experiment, &[other.to_string()])?;
     Ok(a.score - b.score > threshold)
-}
-
-/// The user's model with the selected terms at their estimates and the calibrated base
-/// parameters at theirs: what the recording says the motor is.
-pub fn truth_problem(base: &Problem, selected: &CandidateFit) -> Result<Problem, AppError> {
-    let mut problem = problem_with(base, &selected.added)?;
-    for (name, &value) in &selected.theta {
-        problem.model.set_value(name, value);
-    }
-    Ok(problem)
 }

@@ -14,19 +14,15 @@
 
 use std::collections::BTreeMap;
 
-use crate::app::AppError;
-use crate::app::problem::Problem;
 use crate::bayes::{CalibrationPosterior, ModelSettings};
 use crate::density::LogDensity;
-use crate::io::CalibrateEntry;
-use crate::motor::{ActiveTerm, Term};
+use crate::error::Error;
 use crate::optimize::{MapEstimate, MapSettings, find_map};
 use crate::parameter::Support;
+use crate::study::{BOUNDED_STARTS, Problem};
 
-/// Starting values tried for a parameter with a bounded support (a time in the record): the
-/// likelihood is multimodal in a switching time, so one start from the prior's median can stop
-/// in the wrong valley.
-pub const BOUNDED_STARTS: [f64; 7] = [0.1, 0.25, 0.4, 0.5, 0.6, 0.75, 0.9];
+use super::coincide::{InputCoincidence, coincidence};
+use super::settings::uses_laplace;
 
 /// How many starts a long record's MAP search keeps (the best by their log density).
 pub const LONG_RECORD_STARTS: usize = 2;
@@ -34,11 +30,18 @@ pub const LONG_RECORD_STARTS: usize = 2;
 /// Multiples of the prior's median at which a one-sided added parameter is also started.
 pub const POSITIVE_START_FACTORS: [f64; 1] = [4.0];
 
-/// One fitted candidate model.
+/// One fitted candidate model: what every stage of the diagnosis takes. It keeps its problem,
+/// its BM1 posterior and its MAP, so that no stage builds them again.
 #[derive(Clone, Debug)]
-pub struct CandidateFit {
+pub struct Candidate {
     /// The terms switched on beyond the user's model, in the order they were added.
     pub added: Vec<String>,
+    /// The user's problem with these terms on, calibrated with their default priors (BM1).
+    pub problem: Problem,
+    /// Its BM1 posterior.
+    pub posterior: CalibrationPosterior,
+    /// Its MAP (with the Hessian and the Laplace evidence).
+    pub map: MapEstimate,
     /// How many parameters they add.
     pub n_added: usize,
     pub log_likelihood: f64,
@@ -46,8 +49,6 @@ pub struct CandidateFit {
     pub log_evidence_laplace: f64,
     /// log L̂ − ½·d·ln N.
     pub score: f64,
-    /// The MAP in the posterior's unconstrained coordinates.
-    pub x: Vec<f64>,
     /// Calibrated parameters at the MAP (physical values), keyed by the model's names.
     pub theta: BTreeMap<String, f64>,
     /// Added one-sided parameters the data do not hold away from their bound: the Laplace
@@ -55,62 +56,36 @@ pub struct CandidateFit {
     pub at_bound: Vec<String>,
     /// The importance-sampling check of the Laplace evidence, where it was run; the score then
     /// includes its correction.
-    pub confirmation: Option<super::confirm::Confirmation>,
+    pub confirmation: Option<Confirmation>,
     /// A switching time fitted at a step of a recorded input: confounded with the input, so
     /// ranked but never selected.
-    pub coincidence: Option<super::coincide::InputCoincidence>,
+    pub coincidence: Option<InputCoincidence>,
 }
 
-/// The problem with `added` switched on (at their defaults) and calibrated with their default
-/// priors, beside what the user's model already calibrates (R when it says nothing); BM1.
-pub fn problem_with(base: &Problem, added: &[String]) -> Result<Problem, AppError> {
-    let mut problem = base.clone();
-    let mut calibrate = match &base.model.calibrate {
-        Some(entries) => entries.clone(),
-        None => vec![CalibrateEntry {
-            name: "R".into(),
-            prior: None,
-        }],
-    };
-    let speed_scale = base.speed_scale()?;
-    for name in added {
-        if problem.model.terms.iter().any(|t| t.term.name() == name) {
-            return Err(AppError::Usage(format!(
-                "the model already has the term {name}"
-            )));
+/// The importance-sampling estimate of a candidate's log evidence (`confirm.rs`).
+pub type Confirmation = crate::evidence::Evidence;
+
+impl Candidate {
+    /// The user's model with these terms at their estimates and the calibrated base parameters
+    /// at theirs: what the recording says the motor is.
+    pub fn fitted_problem(&self) -> Problem {
+        let mut problem = self.problem.clone();
+        for (name, &value) in &self.theta {
+            problem.model.set_value(name, value);
         }
-        let term = Term::named_for(name, speed_scale).ok_or_else(|| {
-            AppError::Usage(format!(
-                "unknown candidate '{name}' (known: {})",
-                Term::NAMES.join(", ")
-            ))
-        })?;
-        for p in term.params() {
-            calibrate.push(CalibrateEntry {
-                name: format!("{name}.{}", p.key),
-                prior: None,
-            });
-        }
-        problem.model.terms.push(ActiveTerm::with_defaults(term));
+        problem
     }
-    problem.model.terms.sort_by_key(|t| t.term.rank());
-    problem.model.calibrate = Some(calibrate);
-    problem.model.schema = 2;
-    problem.model.discrepancy = None;
-    Ok(problem)
-}
 
-/// Observed values in all recordings and channels: the N of the score.
-pub fn n_observations(problem: &Problem) -> usize {
-    problem
-        .recordings
-        .iter()
-        .map(|r| r.n_samples() * r.channels.len())
-        .sum()
+    /// The noise σ of each channel of the first record at the MAP.
+    pub fn noise_sd(&self) -> Vec<f64> {
+        (0..self.posterior.forward(0).channels().len())
+            .map(|c| self.map.x[self.posterior.log_sigma_index(0, c)].exp())
+            .collect()
+    }
 }
 
 /// The MAP of BM1 for `base` with `added` switched on, and its score.
-pub fn fit_candidate(base: &Problem, added: &[String]) -> Result<CandidateFit, AppError> {
+pub fn fit_candidate(base: &Problem, added: &[String]) -> Result<Candidate, Error> {
     fit_candidate_from(base, added, None)
 }
 
@@ -120,11 +95,11 @@ pub fn fit_candidate(base: &Problem, added: &[String]) -> Result<CandidateFit, A
 pub fn fit_candidate_from(
     base: &Problem,
     added: &[String],
-    warm: Option<&CandidateFit>,
-) -> Result<CandidateFit, AppError> {
-    let problem = problem_with(base, added)?;
+    warm: Option<&Candidate>,
+) -> Result<Candidate, Error> {
+    let problem = base.with_terms(added)?;
     let mut posterior = problem.posterior(&ModelSettings::bm1())?;
-    let map = best_map(&mut posterior, warm, super::fits::uses_laplace(&problem))?;
+    let map = best_map(&mut posterior, warm, uses_laplace(&problem))?;
     let log_likelihood = posterior.log_likelihood(&map.x)?;
     let added_names: Vec<String> = posterior
         .calibrated()
@@ -133,7 +108,7 @@ pub fn fit_candidate_from(
         .map(|c| c.name.clone())
         .collect();
     let n_added = added_names.len();
-    let n = n_observations(&problem) as f64;
+    let n = problem.n_observations() as f64;
     let theta_values = posterior.theta_of(&map.x);
     let mut theta = BTreeMap::new();
     let mut at_bound = Vec::new();
@@ -154,14 +129,16 @@ pub fn fit_candidate_from(
             at_bound.push(c.name.clone());
         }
     }
-    let coincidence = super::coincide::coincidence(&problem, &mut posterior, &map)?;
-    Ok(CandidateFit {
+    let coincidence = coincidence(&problem, &mut posterior, &map)?;
+    Ok(Candidate {
         added: added.to_vec(),
+        problem,
+        posterior,
         n_added,
         log_likelihood,
         log_evidence_laplace: map.log_evidence_laplace,
         score: log_likelihood - 0.5 * n_added as f64 * n.ln(),
-        x: map.x,
+        map,
         theta,
         at_bound,
         confirmation: None,
@@ -173,9 +150,9 @@ pub fn fit_candidate_from(
 /// several starts across its support: the best one.
 fn best_map(
     posterior: &mut CalibrationPosterior,
-    warm: Option<&CandidateFit>,
+    warm: Option<&Candidate>,
     long_record: bool,
-) -> Result<MapEstimate, AppError> {
+) -> Result<MapEstimate, Error> {
     let mut start = posterior.initial_point()?;
     let known = |name: &str| warm.and_then(|w| w.theta.get(name).copied());
     for (i, c) in posterior.calibrated().iter().enumerate() {
@@ -256,13 +233,13 @@ fn best_map(
     match (best, last_error) {
         (Some(map), _) => Ok(map),
         (None, Some(e)) => Err(e.into()),
-        (None, None) => Err(AppError::Numerical("no MAP start".into())),
+        (None, None) => Err(Error::Numerical("no MAP start".into())),
     }
 }
 
 /// A candidate's parameters as the dev set's `answer.json` keys them (unqualified), with R;
 /// the armature reaction also as `I_sat` = 1/κ (null when κ = 0).
-pub fn answer_params(fit: &CandidateFit) -> BTreeMap<String, Option<f64>> {
+pub fn answer_params(fit: &Candidate) -> BTreeMap<String, Option<f64>> {
     let mut out = BTreeMap::new();
     for (name, &value) in &fit.theta {
         let key = match name.split_once('.') {

@@ -9,19 +9,14 @@
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 
-use crate::app::AppError;
-use crate::app::problem::Problem;
+use crate::error::Error;
 use crate::io::Recording;
 use crate::motor::Base;
 use crate::plot::MissingTorqueCurve;
+use crate::study::Problem;
 
-use super::candidates::CandidateFit;
-use super::ties::truth_problem;
-
-/// Smoothing window of the measured speed and input before differentiating [s]: 20 ms, short
-/// against the mechanical time constants (0.5 s on EMPS, 1.7 s on HSM150) and long against
-/// 1-ms sampling, whose quantised speed would otherwise make ω̇ pure noise.
-pub(super) const SMOOTHING_S: f64 = 0.02;
+use super::candidate::Candidate;
+use super::settings::SMOOTHING_S;
 
 /// Speed bins of the figure.
 const BINS: usize = 40;
@@ -77,11 +72,11 @@ fn derivative(values: &[f64], times: &[f64]) -> Vec<f64> {
 /// A record's speed and drive input as measured, smoothed over [`SMOOTHING_S`]: ω and the
 /// current (`current_driven`), or the derivative of q and the force over c_g
 /// (`position_loop`); `None` for the voltage-driven motor.
-fn measured(problem: &Problem, recording: &Recording) -> Result<Option<[Vec<f64>; 2]>, AppError> {
+fn measured(problem: &Problem, recording: &Recording) -> Result<Option<[Vec<f64>; 2]>, Error> {
     let times = &recording.time;
     let dt = (recording.last_time() - times[0]) / (times.len().max(2) - 1) as f64;
     let width = ((SMOOTHING_S / dt).round() as usize).max(1) | 1;
-    let missing = |what: &str| AppError::Usage(format!("{}: no {what}", recording.source));
+    let missing = |what: &str| Error::invalid(format!("{}: no {what}", recording.source));
     let channel = |name: &str| recording.channel(name).ok_or_else(|| missing(name));
     Ok(Some(match problem.model.base {
         Base::CurrentDriven => {
@@ -104,7 +99,7 @@ fn measured(problem: &Problem, recording: &Recording) -> Result<Option<[Vec<f64>
 }
 
 /// (speed, missing torque) at every sample of every record, for the model of `problem`.
-fn samples(problem: &Problem) -> Result<Vec<(f64, f64)>, AppError> {
+fn samples(problem: &Problem) -> Result<Vec<(f64, f64)>, Error> {
     let mut out = Vec::new();
     for recording in &problem.recordings {
         let Some([speed, input]) = measured(problem, recording)? else {
@@ -121,7 +116,7 @@ fn samples(problem: &Problem) -> Result<Vec<(f64, f64)>, AppError> {
 /// Whether a drive base's records hold motion in both directions (measured speed beyond
 /// [`MOVING_SHARE`] of its top on both sides of zero); `true` for the voltage-driven motor, whose
 /// candidates this does not concern.
-pub fn records_reverse(problem: &Problem) -> Result<bool, AppError> {
+pub fn records_reverse(problem: &Problem) -> Result<bool, Error> {
     let mut speeds = Vec::new();
     for recording in &problem.recordings {
         match measured(problem, recording)? {
@@ -137,14 +132,14 @@ pub fn records_reverse(problem: &Problem) -> Result<bool, AppError> {
 /// The fingerprint and the binned curve of `fit`'s model (`none` for the model as given).
 pub fn fingerprint(
     problem: &Problem,
-    fit: &CandidateFit,
+    fit: &Candidate,
     label: &str,
-) -> Result<Option<(StateFingerprint, MissingTorqueCurve)>, AppError> {
+) -> Result<Option<(StateFingerprint, MissingTorqueCurve)>, Error> {
     let base = problem.model.base;
     if !base.is_drive() {
         return Ok(None);
     }
-    let model_problem = truth_problem(problem, fit)?;
+    let model_problem = fit.fitted_problem();
     let points = samples(&model_problem)?;
     let top = points.iter().fold(0.0f64, |a, p| a.max(p.0.abs()));
     let moving: Vec<(f64, f64)> = points
@@ -164,7 +159,7 @@ pub fn fingerprint(
         .clone()
         .svd(true, true)
         .solve(&y, 1e-12)
-        .map_err(|e| AppError::Numerical(e.to_string()))?;
+        .map_err(|e| Error::Numerical(e.to_string()))?;
     let residual = &y - &design * &coefficients;
     let n = moving.len().max(1) as f64;
     let rms = (y.norm_squared() / n).sqrt();

@@ -5,11 +5,9 @@
 
 use nalgebra::DMatrix;
 
-use crate::app::AppError;
-use crate::app::problem::Problem;
+use crate::error::Error;
 use crate::ode::SolverSettings;
-
-use super::candidates::problem_with;
+use crate::study::Problem;
 
 /// |cos| above which two weighted sensitivity columns count as collinear: 0.99 leaves 1% of
 /// the column's squared length to tell them apart, which a concealed effect below 1.5σ cannot
@@ -22,8 +20,10 @@ pub fn collinear_pairs(
     candidates: &[String],
     resistance: f64,
     noise_sd: &[f64],
-) -> Result<Vec<(String, String, f64)>, AppError> {
-    let problem = problem_with(base, candidates)?;
+) -> Result<Vec<(String, String, f64)>, Error> {
+    // Every candidate at once: a problem no single candidate has, built for its forward
+    // model alone.
+    let problem = base.with_terms(candidates)?;
     let forward = problem.forward(SolverSettings::default())?;
     let names = forward.calibrated_names();
     let mut theta = forward.nominal_calibrated();
@@ -41,7 +41,7 @@ pub fn collinear_pairs(
     let mut jacobian = DMatrix::zeros(forward.n_outputs(), names.len());
     forward
         .simulate_with_sensitivities(&theta, &mut out, &mut jacobian)
-        .map_err(|e| AppError::Numerical(e.to_string()))?;
+        .map_err(|e| Error::Numerical(e.to_string()))?;
     let m = forward.times().len();
     for (c, sd) in noise_sd.iter().enumerate().take(forward.channels().len()) {
         for i in 0..m {

@@ -5,15 +5,20 @@ use std::path::{Path, PathBuf};
 
 use crate::bayes::{CalibratedParameter, CalibrationPosterior, ModelSettings, Observations};
 use crate::forward::ForwardModel;
-use crate::io::{ModelFile, Recording, read_model_file, read_recording_for};
-use crate::motor::{MotorModel, MotorParameters, VoltageInput};
+use crate::io::{CalibrateEntry, ModelFile, Recording, read_model_file, read_recording_for};
+use crate::motor::{ActiveTerm, MotorModel, MotorParameters, Term, VoltageInput};
 use crate::ode::SolverSettings;
 use crate::synthetic::{PaperSetup, SyntheticData, paper_measurements};
 
-use super::AppError;
+use crate::error::Error;
 
 /// ε of a drive base's vague noise prior InvGamma(ε, ε²) (see [`Problem::posterior`]).
 const VAGUE_NOISE_SHAPE: f64 = 1e-3;
+
+/// Starting values tried for a parameter with a bounded support (a time in the record): the
+/// likelihood is multimodal in a switching time, so one start from the prior's median can stop
+/// in the wrong valley.
+pub const BOUNDED_STARTS: [f64; 7] = [0.1, 0.25, 0.4, 0.5, 0.6, 0.75, 0.9];
 
 /// What is known only in a synthetic experiment: the truth behind the data.
 #[derive(Clone, Debug)]
@@ -37,10 +42,9 @@ pub struct Problem {
 
 impl Problem {
     /// The paper's experiment for a noise seed: data from φ = 1, model with c_g = 0.009.
-    pub fn paper(seed: u64) -> Result<Self, AppError> {
+    pub fn paper(seed: u64) -> Result<Self, Error> {
         let setup = PaperSetup::default();
-        let data =
-            paper_measurements(&setup, seed).map_err(|e| AppError::Numerical(e.to_string()))?;
+        let data = paper_measurements(&setup, seed).map_err(|e| Error::Numerical(e.to_string()))?;
         let model = ModelFile {
             motor: MotorParameters::paper_simulation_model(),
             ..ModelFile::default()
@@ -56,9 +60,9 @@ impl Problem {
 
     /// Recordings (one or more) and a model file; every recording is read with the model
     /// file's `[channels]`.
-    pub fn from_files(data: &[PathBuf], model: &Path) -> Result<Self, AppError> {
+    pub fn from_files(data: &[PathBuf], model: &Path) -> Result<Self, Error> {
         if data.is_empty() {
-            return Err(AppError::Usage("no recording given (--data)".into()));
+            return Err(Error::setting("data", "", "no recording given"));
         }
         let model_file = read_model_file(model)?;
         let recordings = data
@@ -84,15 +88,15 @@ impl Problem {
     }
 
     /// The model driven by a recording's input, with the model file's terms.
-    pub fn model_for(&self, recording: &Recording) -> Result<MotorModel, AppError> {
+    pub fn model_for(&self, recording: &Recording) -> Result<MotorModel, Error> {
         self.model
             .model_for_recording(recording)
-            .map_err(AppError::Usage)
+            .map_err(Error::invalid)
     }
 
     /// A drive base's speed scale: the largest over its records; `None` for the voltage-driven
     /// motor.
-    pub fn speed_scale(&self) -> Result<Option<f64>, AppError> {
+    pub fn speed_scale(&self) -> Result<Option<f64>, Error> {
         if !self.model.base.is_drive() {
             return Ok(None);
         }
@@ -107,7 +111,7 @@ impl Problem {
 
     /// What is calibrated: the `[calibrate]` table's parameters in the order of the model's
     /// parameter vector, or R alone.
-    pub fn calibrated_names(&self) -> Result<Vec<String>, AppError> {
+    pub fn calibrated_names(&self) -> Result<Vec<String>, Error> {
         let Some(entries) = &self.model.calibrate else {
             return Ok(vec!["R".into()]);
         };
@@ -118,7 +122,7 @@ impl Problem {
                 model
                     .parameter_index(&e.name)
                     .map(|i| (i, e.name.clone()))
-                    .ok_or_else(|| AppError::Usage(format!("unknown parameter '{}'", e.name)))
+                    .ok_or_else(|| Error::invalid(format!("unknown parameter '{}'", e.name)))
             })
             .collect::<Result<_, _>>()?;
         names.sort();
@@ -126,19 +130,19 @@ impl Problem {
     }
 
     /// The forward model of each recording.
-    pub fn forward_models(&self, solver: SolverSettings) -> Result<Vec<ForwardModel>, AppError> {
+    pub fn forward_models(&self, solver: SolverSettings) -> Result<Vec<ForwardModel>, Error> {
         let calibrated = self.calibrated_names()?;
         self.recordings
             .iter()
             .map(|r| {
                 ForwardModel::new(self.model_for(r)?, r.time.clone(), &calibrated, solver)
-                    .map_err(|e| AppError::Usage(format!("{}: {e}", r.source)))
+                    .map_err(|e| Error::invalid(format!("{}: {e}", r.source)))
             })
             .collect()
     }
 
     /// The forward model of the first recording.
-    pub fn forward(&self, solver: SolverSettings) -> Result<ForwardModel, AppError> {
+    pub fn forward(&self, solver: SolverSettings) -> Result<ForwardModel, Error> {
         Ok(self.forward_models(solver)?.remove(0))
     }
 
@@ -165,7 +169,55 @@ impl Problem {
         settings
     }
 
-    pub fn posterior(&self, settings: &ModelSettings) -> Result<CalibrationPosterior, AppError> {
+    /// The problem with `added` switched on (at their defaults) and calibrated with their default
+    /// priors, beside what the user's model already calibrates (R when it says nothing); BM1.
+    pub fn with_terms(&self, added: &[String]) -> Result<Problem, Error> {
+        let base = self;
+        let mut problem = base.clone();
+        let mut calibrate = match &base.model.calibrate {
+            Some(entries) => entries.clone(),
+            None => vec![CalibrateEntry {
+                name: "R".into(),
+                prior: None,
+            }],
+        };
+        let speed_scale = base.speed_scale()?;
+        for name in added {
+            if problem.model.terms.iter().any(|t| t.term.name() == name) {
+                return Err(Error::invalid(format!(
+                    "the model already has the term {name}"
+                )));
+            }
+            let term = Term::named_for(name, speed_scale).ok_or_else(|| {
+                Error::invalid(format!(
+                    "unknown candidate '{name}' (known: {})",
+                    Term::NAMES.join(", ")
+                ))
+            })?;
+            for p in term.params() {
+                calibrate.push(CalibrateEntry {
+                    name: format!("{name}.{}", p.key),
+                    prior: None,
+                });
+            }
+            problem.model.terms.push(ActiveTerm::with_defaults(term));
+        }
+        problem.model.terms.sort_by_key(|t| t.term.rank());
+        problem.model.calibrate = Some(calibrate);
+        problem.model.schema = 2;
+        problem.model.discrepancy = None;
+        Ok(problem)
+    }
+
+    /// Observed values in all recordings and channels: the N of a score's ½·d·ln N.
+    pub fn n_observations(&self) -> usize {
+        self.recordings
+            .iter()
+            .map(|r| r.n_samples() * r.channels.len())
+            .sum()
+    }
+
+    pub fn posterior(&self, settings: &ModelSettings) -> Result<CalibrationPosterior, Error> {
         // The paper's InvGamma(1, 1) on σ suits its channels (A and rad/s, σ of order 1). A
         // drive base measures in whatever unit the rig has (µm of position on a ball screw,
         // where it would put −10⁵ nats on the truth), so its noise prior is the vague
@@ -192,7 +244,7 @@ impl Problem {
                 .iter()
                 .map(|name| {
                     recording.channel(name).map(|v| v.to_vec()).ok_or_else(|| {
-                        AppError::Usage(format!("{}: no channel '{name}'", recording.source))
+                        Error::invalid(format!("{}: no channel '{name}'", recording.source))
                     })
                 })
                 .collect::<Result<Vec<_>, _>>()?;
@@ -207,7 +259,7 @@ impl Problem {
             records.push((forward, obs));
         }
         let Some(entries) = &self.model.calibrate else {
-            return CalibrationPosterior::new(records, settings).map_err(AppError::Usage);
+            return CalibrationPosterior::new(records, settings).map_err(Error::invalid);
         };
         // Priors scaled to the longest recording: a load step may happen in any of them.
         let longest = records
@@ -226,10 +278,10 @@ impl Problem {
                     .find(|e| e.name == spec.name)
                     .and_then(|e| e.prior);
                 CalibratedParameter::new(spec, prior)
-                    .map_err(|e| AppError::Usage(format!("{}: {e}", self.label)))
+                    .map_err(|e| Error::invalid(format!("{}: {e}", self.label)))
             })
             .collect::<Result<Vec<_>, _>>()?;
-        CalibrationPosterior::with_parameters(records, theta, settings).map_err(AppError::Usage)
+        CalibrationPosterior::with_parameters(records, theta, settings).map_err(Error::invalid)
     }
 }
 
@@ -254,7 +306,7 @@ fn paper_reference(
     setup: &PaperSetup,
     data: &SyntheticData,
     model: &MotorParameters,
-) -> Result<Reference, AppError> {
+) -> Result<Reference, Error> {
     let at_true_resistance = MotorParameters {
         resistance: setup.truth.resistance,
         ..model.clone()
@@ -266,11 +318,11 @@ fn paper_reference(
         &[] as &[&str],
         SolverSettings::for_data_generation(),
     )
-    .map_err(AppError::Usage)?;
+    .map_err(Error::invalid)?;
     let mut g_phi = vec![0.0; forward.n_outputs()];
     forward
         .simulate(&[], &mut g_phi)
-        .map_err(|e| AppError::Numerical(e.to_string()))?;
+        .map_err(|e| Error::Numerical(e.to_string()))?;
     let m = data.times.len();
     let discrepancy = (0..data.noise_free.len())
         .map(|c| {

@@ -30,16 +30,15 @@
 
 use serde::Serialize;
 
-use crate::app::AppError;
-use crate::app::problem::Problem;
 use crate::bayes::CalibrationPosterior;
 use crate::diagnostics::ess_mean;
+use crate::error::Error;
 use crate::io::Recording;
 use crate::optimize::MapEstimate;
 use crate::parameter::Support;
+use crate::study::Problem;
 
-use super::EVIDENCE_THRESHOLD;
-use super::state::SMOOTHING_S;
+use super::settings::{EVIDENCE_THRESHOLD, SMOOTHING_S};
 
 /// √26: the sd of a least-squares change point in units of (σ/Δ)² samples.
 const CHANGE_POINT_SD: f64 = 5.0990195135927845;
@@ -206,7 +205,7 @@ pub fn coincidence(
     problem: &Problem,
     posterior: &mut CalibrationPosterior,
     map: &MapEstimate,
-) -> Result<Option<InputCoincidence>, AppError> {
+) -> Result<Option<InputCoincidence>, Error> {
     if problem.recordings.len() != 1 {
         return Ok(None);
     }
@@ -232,7 +231,7 @@ pub fn coincidence(
     }
     let residuals = posterior
         .residuals(&map.x, 0)
-        .map_err(|e| AppError::Numerical(e.to_string()))?;
+        .map_err(|e| Error::Numerical(e.to_string()))?;
     let tau = residuals
         .iter()
         .map(|r| {

@@ -1,26 +1,29 @@
-//! The diagnosis as a report: ties and notes, the sampled fits before and after, where the
-//! discrepancy still shows, the JSON contract, the human summary, and the files in `--out`.
+//! The diagnosis as data: ties and notes, the sampled fits before and after, where the
+//! discrepancy still shows, and the JSON contract (`Diagnosis` serialises to what `diagnose
+//! --json` writes). The files and the human summary are the command's.
 
 use std::collections::BTreeMap;
-use std::fmt::Write;
 use std::time::Instant;
 
 use serde::Serialize;
 
-use crate::app::AppError;
-use crate::app::predictive::{plot_discrepancy, plot_predictive, posterior_predictive};
-use crate::app::problem::Problem;
 use crate::bayes::ModelSettings;
-use crate::io::write_model_file;
-use crate::motor::Term;
+use crate::error::Error;
+use crate::io::ModelFile;
+use crate::plot::MissingTorqueCurve;
+use crate::study::Problem;
 
-use super::candidates::{CandidateFit, answer_params};
+use super::Progress;
+use super::candidate::{Candidate, Confirmation, answer_params};
 use super::coincide::InputCoincidence;
 use super::fits::{self, Convergence, FitSummary, Mismatch, SampledFit};
 use super::screen::collinear_pairs;
+use super::selection::Selection;
+use super::settings::{
+    DiscoverSettings, EVIDENCE_THRESHOLD, FitStage, LAPLACE_DRAWS, uses_laplace,
+};
 use super::state::{StateFingerprint, fingerprint, reading};
-use super::ties::{separating_input, truth_problem};
-use super::{DiagnoseOptions, EVIDENCE_THRESHOLD, Selection};
+use super::ties::separating_input;
 
 #[derive(Clone, Debug, Serialize)]
 pub struct RankEntry {
@@ -35,7 +38,7 @@ pub struct RankEntry {
     /// Parameters the data do not hold away from their bound.
     pub at_bound: Vec<String>,
     /// The importance-sampling check of the Laplace evidence, for a doubtful leader.
-    pub confirmation: Option<super::confirm::Confirmation>,
+    pub confirmation: Option<Confirmation>,
     /// The input step its switching time coincides with: confounded with the input, not
     /// selected.
     pub coincides_with_input_step: Option<InputCoincidence>,
@@ -87,10 +90,28 @@ pub struct Diagnosis {
     pub ranking_s: f64,
     pub selection_s: f64,
     pub runtime_s: f64,
+    /// The files the command wrote (the library writes none).
     pub outputs: Vec<String>,
+    /// The sampled fits, in the order they ran, for the command's figures.
+    #[serde(skip)]
+    pub fits: Vec<StageFit>,
+    /// Drive bases: the missing torque against speed before and after, binned.
+    #[serde(skip)]
+    pub missing_torque: Vec<MissingTorqueCurve>,
+    /// The model file with the selected terms added and the posterior means as values (after
+    /// the sampled fits), calibrated with their default priors.
+    #[serde(skip)]
+    pub amended_model: Option<ModelFile>,
 }
 
-fn entry(fit: &CandidateFit, none: &CandidateFit) -> RankEntry {
+/// One sampled fit of a diagnosis.
+#[derive(Clone, Debug)]
+pub struct StageFit {
+    pub stage: FitStage,
+    pub fit: SampledFit,
+}
+
+fn entry(fit: &Candidate, none: &Candidate) -> RankEntry {
     RankEntry {
         effect: fit.added.first().cloned().unwrap_or_else(|| "none".into()),
         score: fit.score - none.score,
@@ -140,27 +161,18 @@ fn passed_over_note(p: &PassedOver) -> String {
     )
 }
 
-/// The noise σ of each channel at the MAP of the selected model (the noise the simulated
-/// experiments are given).
-fn noise_at_map(problem: &Problem, fit: &CandidateFit) -> Result<Vec<f64>, AppError> {
-    let p = super::problem_with(problem, &fit.added)?;
-    let posterior = p.posterior(&ModelSettings::bm1())?;
-    Ok((0..posterior.forward(0).channels().len())
-        .map(|c| fit.x[posterior.log_sigma_index(0, c)].exp())
-        .collect())
-}
-
 #[allow(clippy::too_many_arguments)]
 pub fn assemble(
     problem: &Problem,
-    options: &DiagnoseOptions,
+    settings: &DiscoverSettings,
     k: usize,
     candidates: &[String],
-    ranking: Vec<CandidateFit>,
+    ranking: Vec<Candidate>,
     selection: Selection,
     started: Instant,
     [ranking_s, selection_s]: [f64; 2],
-) -> Result<Diagnosis, AppError> {
+    progress: &impl Fn(Progress),
+) -> Result<Diagnosis, Error> {
     let none = ranking
         .iter()
         .find(|f| f.added.is_empty())
@@ -189,7 +201,7 @@ pub fn assemble(
     let mut ties = Vec::new();
     let mut tie_experiments = BTreeMap::new();
     if let Some(first) = ranking.iter().find(|f| f.added.first() == Some(&selected)) {
-        let noise = noise_at_map(problem, first)?;
+        let noise = first.noise_sd();
         for other in &ranking {
             let Some(name) = other.added.first() else {
                 continue;
@@ -207,7 +219,7 @@ pub fn assemble(
                 name,
                 &noise,
                 EVIDENCE_THRESHOLD,
-                options.run.seed,
+                settings.run.seed,
             )? {
                 Some(input) => {
                     ties.push(name.clone());
@@ -228,7 +240,7 @@ pub fn assemble(
     }
     notes.extend(passed_over.iter().map(passed_over_note));
     let resistance = none.theta.get("R").copied().unwrap_or(f64::NAN);
-    let none_noise = noise_at_map(problem, &none)?;
+    let none_noise = none.noise_sd();
     for (a, b, cos) in collinear_pairs(problem, candidates, resistance, &none_noise)? {
         notes.push(format!(
             "sensitivities of {a} and {b} are collinear on this recording (cos {cos:.4}): \
@@ -244,7 +256,7 @@ pub fn assemble(
     }
 
     let mut state = Vec::new();
-    let mut curves = Vec::new();
+    let mut missing_torque = Vec::new();
     for (fit, label) in [(&none, "before"), (&selected_fit, "after")] {
         if label == "after" && selected_set.is_empty() {
             continue;
@@ -252,7 +264,7 @@ pub fn assemble(
         if let Some((f, curve)) = fingerprint(problem, fit, label)? {
             notes.push(reading(&f));
             state.push(f);
-            curves.push(curve);
+            missing_torque.push(curve);
         }
     }
     let mut tied_pairs = Vec::new();
@@ -286,93 +298,92 @@ pub fn assemble(
         residual_mismatch: false,
         convergence: BTreeMap::new(),
         threshold: EVIDENCE_THRESHOLD,
-        units: parameter_units(problem, &selected_set)?,
+        units: parameter_units(&selected_fit.problem)?,
         discrepancy_degree: k,
-        seed: options.run.seed,
+        seed: settings.run.seed,
         ranking_s,
         selection_s,
         runtime_s: 0.0,
         outputs: Vec::new(),
+        fits: Vec::new(),
+        missing_torque,
+        amended_model: None,
     };
-    if !options.rank_only {
-        sampled_fits(problem, options, k, &selected_fit, &mut diagnosis)?;
-    }
-    if let (Some(out), false) = (&options.out, curves.is_empty()) {
-        std::fs::create_dir_all(out)?;
-        let path = out.join("missing-torque.png");
-        let plot = crate::plot::MissingTorquePlot {
-            title: "the torque the model misses, against speed".into(),
-            speed_unit: problem.model.base.unit("rad/s").into(),
-            torque_unit: problem.model.base.unit("N·m").into(),
-            curves,
-        };
-        crate::plot::missing_torque(&path, &plot).map_err(|e| AppError::Output(e.to_string()))?;
-        diagnosis.outputs.push(path.display().to_string());
+    if !settings.rank_only {
+        sampled_fits(
+            problem,
+            settings,
+            k,
+            &none,
+            &selected_fit,
+            &mut diagnosis,
+            progress,
+        )?;
     }
     diagnosis.runtime_s = started.elapsed().as_secs_f64();
-    if let Some(path) = &options.json {
-        diagnosis.outputs.push(path.display().to_string());
-        let text = serde_json::to_string_pretty(&diagnosis)
-            .map_err(|e| AppError::Output(e.to_string()))?;
-        crate::io::write_atomically(path, text.as_bytes())?;
-    }
     Ok(diagnosis)
 }
 
 /// BM1 before and after (noise, RMSE, whiteness, parameters), BM2 before and after (where δ
-/// excludes zero), and the files in `--out`.
+/// excludes zero), and the amended model.
 fn sampled_fits(
     problem: &Problem,
-    options: &DiagnoseOptions,
+    settings: &DiscoverSettings,
     k: usize,
-    selected: &CandidateFit,
+    none: &Candidate,
+    selected: &Candidate,
     diagnosis: &mut Diagnosis,
-) -> Result<(), AppError> {
-    let before_problem = super::problem_with(problem, &[])?;
-    let after_problem = truth_problem(problem, selected)?;
+    progress: &impl Fn(Progress),
+) -> Result<(), Error> {
+    let before_problem = none.problem.clone();
+    let after_problem = selected.fitted_problem();
     // δ after: the selected terms held at their estimates, the user's own parameters sampled.
     // Sampling the terms too would let δ and a term trade the same shape (a funnel that costs
     // NUTS divergences and most of the run) and asks nothing the BM1 fit has not answered.
     let mut held_problem = after_problem.clone();
     held_problem.model.calibrate = before_problem.model.calibrate.clone();
-    let mut run = options.run.clone();
-    let stages = [
-        ("before", &before_problem, ModelSettings::bm1()),
-        ("after", &after_problem, ModelSettings::bm1()),
-        ("before_bm2", &before_problem, ModelSettings::bm2(k)),
-        ("after_bm2", &held_problem, ModelSettings::bm2(k)),
-    ];
-    let mut sampled: Vec<(String, SampledFit)> = Vec::new();
-    for (i, (name, p, settings)) in stages.into_iter().enumerate() {
-        run.seed = options.run.seed.wrapping_add(i as u64);
-        if name.starts_with("after") && diagnosis.selected_set.is_empty() {
+    let mut run = settings.run.clone();
+    for (i, stage) in FitStage::ALL.into_iter().enumerate() {
+        run.seed = settings.run.seed.wrapping_add(i as u64);
+        if stage.is_after() && diagnosis.selected_set.is_empty() {
             continue;
         }
         // A Legendre polynomial of degree K over 20 s of back-and-forth motion is a slow trend,
         // not a locator: long records are located against the state instead.
-        if name.ends_with("bm2") && fits::uses_laplace(problem) {
+        if stage.is_bm2() && uses_laplace(problem) {
             continue;
         }
-        let fit = fits::sample(p, &settings, &run, &format!("{name}: {}", settings.label()))?;
+        let (p, model) = match stage {
+            FitStage::Before => (&before_problem, ModelSettings::bm1()),
+            FitStage::After => (&after_problem, ModelSettings::bm1()),
+            FitStage::BeforeBm2 => (&before_problem, ModelSettings::bm2(k)),
+            FitStage::AfterBm2 => (&held_problem, ModelSettings::bm2(k)),
+        };
+        progress(Progress::Sampling(stage));
+        let mut fit = fits::sample(
+            p,
+            &model,
+            &run,
+            &format!("{}: {}", stage.name(), model.label()),
+        )?;
         diagnosis
             .convergence
-            .insert(name.to_string(), Convergence::of(&fit.run));
-        sampled.push((name.to_string(), fit));
-    }
-    for (name, fit) in sampled.iter_mut() {
-        match name.as_str() {
-            "before" => diagnosis.fit_before = Some(fits::summarize_fit(problem, fit)?),
-            "after" => diagnosis.fit_after = Some(fits::summarize_fit(problem, fit)?),
-            "before_bm2" => {
-                let (mismatch, _) = fits::mismatches(problem, fit)?;
+            .insert(stage.name().to_string(), Convergence::of(&fit.run));
+        match stage {
+            FitStage::Before => {
+                diagnosis.fit_before = Some(fits::summarize_fit(problem, &mut fit)?)
+            }
+            FitStage::After => diagnosis.fit_after = Some(fits::summarize_fit(problem, &mut fit)?),
+            FitStage::BeforeBm2 => {
+                let (mismatch, _) = fits::mismatches(problem, &mut fit)?;
                 if diagnosis.selected_set.is_empty() {
                     diagnosis.residual_mismatch =
                         mismatch.iter().any(|m| fits::substantial(m, problem));
                 }
                 diagnosis.mismatch = mismatch;
             }
-            "after_bm2" => {
-                let (left, _) = fits::mismatches(problem, fit)?;
+            FitStage::AfterBm2 => {
+                let (left, _) = fits::mismatches(problem, &mut fit)?;
                 let substantial: Vec<&Mismatch> = left
                     .iter()
                     .filter(|m| fits::substantial(m, problem))
@@ -386,13 +397,13 @@ fn sampled_fits(
                     ));
                 }
             }
-            _ => {}
         }
+        diagnosis.fits.push(StageFit { stage, fit });
     }
     if diagnosis.fit_after.is_none() {
         diagnosis.fit_after = diagnosis.fit_before.clone();
     }
-    if fits::uses_laplace(problem) {
+    if uses_laplace(problem) {
         diagnosis.notes.push(format!(
             "{} samples: the fits before and after are Laplace approximations at the MAP \
              ({} draws from the Gaussian), not NUTS runs, and the BM2 band in time is skipped",
@@ -401,203 +412,24 @@ fn sampled_fits(
                 .iter()
                 .map(|r| r.n_samples())
                 .sum::<usize>(),
-            fits::LAPLACE_DRAWS
+            LAPLACE_DRAWS
         ));
     }
-    if let Some(out) = &options.out {
-        std::fs::create_dir_all(out)?;
-        for (name, fit) in sampled.iter_mut() {
-            for r in 0..fit.posterior.n_records() {
-                let p = posterior_predictive(&mut fit.posterior, &fit.run.chains, r)?;
-                let suffix = if problem.recordings.len() > 1 {
-                    format!("-{}", r + 1)
-                } else {
-                    String::new()
-                };
-                let path = if name.ends_with("bm2") {
-                    let path = out.join(format!("discrepancy-{name}{suffix}.png"));
-                    let when = name.trim_end_matches("_bm2");
-                    plot_discrepancy(&path, &format!("δ {when} (BM2, K = {k})"), &p, None)?;
-                    path
-                } else {
-                    let path = out.join(format!("fit-{name}{suffix}.png"));
-                    let title = if name == "before" {
-                        "the model as given (BM1)".to_string()
-                    } else {
-                        format!("with {} (BM1)", diagnosis.selected_set.join(" + "))
-                    };
-                    plot_predictive(&path, &title, &p)?;
-                    path
-                };
-                diagnosis.outputs.push(path.display().to_string());
-            }
-        }
-        // The posterior means as the model file's values.
-        let mut model = after_problem.model.clone();
-        for (name, &value) in diagnosis.fit_after.iter().flat_map(|f| &f.params_mean) {
-            model.set_value(name, value);
-        }
-        let path = out.join("model.toml");
-        write_model_file(&path, &model)?;
-        diagnosis.outputs.push(path.display().to_string());
-        let fits_json = serde_json::json!({
-            "before": diagnosis.fit_before,
-            "after": diagnosis.fit_after,
-            "convergence": diagnosis.convergence,
-        });
-        let path = out.join("fit.json");
-        crate::io::write_atomically(
-            &path,
-            serde_json::to_string_pretty(&fits_json)
-                .map_err(|e| AppError::Output(e.to_string()))?
-                .as_bytes(),
-        )?;
-        diagnosis.outputs.push(path.display().to_string());
+    // The posterior means as the model file's values.
+    let mut model = after_problem.model.clone();
+    for (name, &value) in diagnosis.fit_after.iter().flat_map(|f| &f.params_mean) {
+        model.set_value(name, value);
     }
+    diagnosis.amended_model = Some(model);
     Ok(())
 }
 
-fn unit_of(name: &str) -> &'static str {
-    let Some((term, key)) = name.split_once('.') else {
-        return if name == "R" { "Ω" } else { "" };
-    };
-    Term::named(term)
-        .and_then(|t| t.params().iter().find(|p| p.key == key).map(|p| p.unit))
-        .unwrap_or("")
-}
-
-fn parameter_units(
-    problem: &Problem,
-    selected: &[String],
-) -> Result<BTreeMap<String, String>, AppError> {
-    let p = super::problem_with(problem, selected)?;
+/// The unit of every calibrated parameter of `p`, as its base reads it.
+fn parameter_units(p: &Problem) -> Result<BTreeMap<String, String>, Error> {
     let model = p.model_for(p.recording())?;
     Ok(model
         .parameter_specs(&model.magnitudes(1.0))
         .into_iter()
         .map(|spec| (spec.name, spec.unit.to_string()))
         .collect())
-}
-
-/// Four significant figures, in fixed notation where that reads well.
-fn sig(v: f64) -> String {
-    if v == 0.0 || (1e-3..1e4).contains(&v.abs()) {
-        format!("{v:.4}")
-    } else {
-        format!("{v:.3e}")
-    }
-}
-
-/// The human summary.
-pub fn format_diagnosis(d: &Diagnosis) -> String {
-    let mut s = String::new();
-    let _ = writeln!(s, "ranking (score: log L − ½·d·ln N against none, nats):");
-    for e in &d.ranking {
-        let _ = write!(
-            s,
-            "  {:<20} {:>+10.2}   Laplace (default priors) {:>+10.2}",
-            e.effect, e.score, e.log_evidence_laplace
-        );
-        match &e.coincides_with_input_step {
-            Some(c) => {
-                let _ = writeln!(
-                    s,
-                    "   at the {} step at {:.4} s: not selected",
-                    c.input_step.input, c.input_step.time
-                );
-            }
-            None => s.push('\n'),
-        }
-    }
-    if d.selected_set.is_empty() {
-        let _ = writeln!(
-            s,
-            "no candidate beats the model as it is by more than {} nats: nothing missing found",
-            d.threshold
-        );
-    } else {
-        let _ = writeln!(s, "the model lacks {}", d.selected_set.join(" + "));
-        if d.fit_after.is_none() {
-            let _ = writeln!(s, "its MAP:");
-            for (name, value) in &d.selected_params {
-                let unit = d
-                    .units
-                    .get(name)
-                    .map_or_else(|| unit_of(name), String::as_str);
-                let _ = writeln!(s, "  {name} = {value:.5e} {unit}");
-            }
-        }
-        if let Some(after) = &d.fit_after {
-            for (name, mean) in &after.params_mean {
-                let ci = after.params_95.get(name).copied().unwrap_or([f64::NAN; 2]);
-                let _ = writeln!(
-                    s,
-                    "  {name} = {mean:.5e} {} [95%: {:.5e}, {:.5e}]",
-                    d.units
-                        .get(name)
-                        .map_or_else(|| unit_of(name), String::as_str),
-                    ci[0],
-                    ci[1]
-                );
-            }
-        }
-    }
-    if let (Some(b), Some(a)) = (&d.fit_before, &d.fit_after) {
-        let _ = writeln!(
-            s,
-            "log likelihood {:.1} → {:.1} ({:+.1} nats)",
-            b.log_likelihood,
-            a.log_likelihood,
-            a.log_likelihood - b.log_likelihood
-        );
-        for (ch, sb) in &b.sigma {
-            let sa = a.sigma.get(ch).copied().unwrap_or(f64::NAN);
-            let wb = &b.whiteness[ch];
-            let wa = &a.whiteness[ch];
-            let _ = writeln!(
-                s,
-                "σ_{ch} {} → {}; Ljung–Box p {:.2e} → {:.2e}",
-                sig(*sb),
-                sig(sa),
-                wb.p_value,
-                wa.p_value
-            );
-        }
-    }
-    for [a, b] in &d.tied_pairs {
-        let _ = writeln!(
-            s,
-            "{a} and {b} cannot be told apart on these records: add a {} record",
-            d.tie_experiments
-                .get(&format!("{a}/{b}"))
-                .map(String::as_str)
-                .unwrap_or("different")
-        );
-    }
-    for t in &d.ties {
-        let _ = writeln!(
-            s,
-            "cannot be told apart from {t} on this recording: add a {} input",
-            d.tie_experiments
-                .get(t)
-                .map(String::as_str)
-                .unwrap_or("different")
-        );
-    }
-    for m in &d.mismatch {
-        let _ = writeln!(
-            s,
-            "mismatch before: {} from {:.4} s to {:.4} s (|δ| up to {:.2} σ)",
-            m.channel, m.t_start, m.t_end, m.max_over_sigma
-        );
-    }
-    for n in &d.notes {
-        let _ = writeln!(s, "note: {n}");
-    }
-    let _ = writeln!(
-        s,
-        "runtime {:.1} s (ranking {:.1} s, selection {:.1} s)",
-        d.runtime_s, d.ranking_s, d.selection_s
-    );
-    s
 }

@@ -7,17 +7,18 @@ use std::collections::BTreeMap;
 use serde::Serialize;
 use statrs::distribution::{ChiSquared, ContinuousCDF};
 
-use crate::app::AppError;
-use crate::app::fit::posterior_mean;
-use crate::app::predictive::{Predictive, posterior_predictive};
-use crate::app::problem::Problem;
 use crate::bayes::{CalibrationPosterior, ModelSettings};
 use crate::density::LogDensity;
 use crate::diagnostics::autocovariance;
+use crate::error::Error;
 use crate::optimize::{MapSettings, find_map};
 use crate::pipeline::{RunOutput, RunSettings, finish_run, run_sampler};
 use crate::sampler::driver::chain_rng;
 use crate::sampler::{ChainOutput, DrawRecord};
+use crate::study::{Predictive, Problem, posterior_predictive};
+
+use super::settings::{LAPLACE_DRAWS, uses_laplace};
+use crate::pipeline::posterior_mean;
 
 /// Lags of the Ljung–Box statistic: 20, the usual choice for a few hundred samples, long enough
 /// to see the slow drifts a missing term leaves and short against 501 samples.
@@ -92,28 +93,10 @@ impl Convergence {
 }
 
 /// A sampled fit and its posterior, for the figures.
+#[derive(Clone, Debug)]
 pub struct SampledFit {
     pub posterior: CalibrationPosterior,
     pub run: RunOutput,
-}
-
-/// Records longer than this (samples summed over records) are fitted by the Laplace
-/// approximation instead of NUTS: at 20 000–25 000 samples one gradient costs milliseconds, a
-/// NUTS fit minutes per stage, and with that many samples the posterior of a handful of
-/// parameters is Gaussian to well within its own width (Bernstein–von Mises).
-pub const LAPLACE_ABOVE_SAMPLES: usize = 5000;
-
-/// Draws taken from the Laplace approximation: enough for stable 95% intervals.
-pub const LAPLACE_DRAWS: usize = 1000;
-
-/// Whether `problem` is fitted by the Laplace approximation (see [`LAPLACE_ABOVE_SAMPLES`]).
-pub fn uses_laplace(problem: &Problem) -> bool {
-    problem
-        .recordings
-        .iter()
-        .map(|r| r.n_samples())
-        .sum::<usize>()
-        > LAPLACE_ABOVE_SAMPLES
 }
 
 /// Samples `problem` (a candidate problem: terms on, calibrated) under `settings`: NUTS, or for
@@ -123,7 +106,7 @@ pub fn sample(
     settings: &ModelSettings,
     run: &RunSettings,
     label: &str,
-) -> Result<SampledFit, AppError> {
+) -> Result<SampledFit, Error> {
     let mut posterior = problem.posterior(settings)?;
     let run = if uses_laplace(problem) {
         laplace_run(&mut posterior, run.seed)?
@@ -135,7 +118,7 @@ pub fn sample(
 
 /// x = MAP + L⁻ᵀ z with z ~ N(0, I) and L Lᵀ the Hessian at the MAP, as one "chain" of
 /// independent draws, so that every summary and figure downstream reads it like a sampled run.
-fn laplace_run(posterior: &mut CalibrationPosterior, seed: u64) -> Result<RunOutput, AppError> {
+fn laplace_run(posterior: &mut CalibrationPosterior, seed: u64) -> Result<RunOutput, Error> {
     use rand_distr::{Distribution, StandardNormal};
     let started = std::time::Instant::now();
     let start = posterior.initial_point()?;
@@ -144,7 +127,7 @@ fn laplace_run(posterior: &mut CalibrationPosterior, seed: u64) -> Result<RunOut
         ..MapSettings::default()
     };
     let map = find_map(posterior, &start, &settings)?;
-    let (l_inv_t, _) = map.whitening().map_err(AppError::Numerical)?;
+    let (l_inv_t, _) = map.whitening().map_err(Error::Numerical)?;
     let mut rng = chain_rng(seed ^ 0x1a91_ace0, 0);
     let d = map.x.len();
     let names = posterior.output_names();
@@ -201,7 +184,7 @@ fn key(problem: &Problem, record: usize, channel: &str) -> String {
     }
 }
 
-pub fn summarize_fit(problem: &Problem, fit: &mut SampledFit) -> Result<FitSummary, AppError> {
+pub fn summarize_fit(problem: &Problem, fit: &mut SampledFit) -> Result<FitSummary, Error> {
     let mean = posterior_mean(&fit.run);
     let posterior = &mut fit.posterior;
     let mut sigma = BTreeMap::new();
@@ -270,7 +253,7 @@ pub const MISMATCH_MIN_SHARE: f64 = 0.05;
 pub fn mismatches(
     problem: &Problem,
     fit: &mut SampledFit,
-) -> Result<(Vec<Mismatch>, Vec<Predictive>), AppError> {
+) -> Result<(Vec<Mismatch>, Vec<Predictive>), Error> {
     let mut out = Vec::new();
     let mut predictives = Vec::new();
     for r in 0..fit.posterior.n_records() {

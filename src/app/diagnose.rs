@@ -1,0 +1,261 @@
+//! `motorcal diagnose`: reads the recordings and the model, calls [`crate::discover`], and
+//! writes what it found — the JSON report, the figures (fits before and after, δ before and
+//! after, the missing torque), both fits' `fit.json`, the amended `model.toml` — and prints the
+//! human summary.
+
+use std::fmt::Write;
+use std::path::PathBuf;
+
+use crate::discover::{Diagnosis, DiscoverSettings, FitStage, discover};
+use crate::io::write_model_file;
+use crate::motor::Term;
+use crate::pipeline::RunSettings;
+use crate::study::{Problem, posterior_predictive};
+
+use super::AppError;
+use super::figures::{plot_discrepancy, plot_predictive};
+
+pub use crate::discover::METRIC_ADAPTATION;
+
+/// Options of `motorcal diagnose`.
+#[derive(Clone, Debug)]
+pub struct DiagnoseOptions {
+    pub data: Vec<PathBuf>,
+    pub model: PathBuf,
+    pub k: Option<usize>,
+    /// Term names to consider; `None`: every term the model lacks that applies to its base.
+    pub candidates: Option<Vec<String>>,
+    pub run: RunSettings,
+    pub out: Option<PathBuf>,
+    pub json: Option<PathBuf>,
+    /// Skip the sampled fits (ranking, selection and ties only).
+    pub rank_only: bool,
+}
+
+/// The whole command: read, discover, write; returns the report with the files it wrote.
+pub fn diagnose(options: &DiagnoseOptions) -> Result<Diagnosis, AppError> {
+    let started = std::time::Instant::now();
+    let problem = Problem::from_files(&options.data, &options.model)?;
+    let settings = DiscoverSettings {
+        k: options.k,
+        candidates: options.candidates.clone(),
+        run: options.run.clone(),
+        rank_only: options.rank_only,
+    };
+    let mut diagnosis = discover(&problem, &settings)?;
+    if let Some(out) = &options.out {
+        write_figures(&problem, &mut diagnosis, out)?;
+    }
+    diagnosis.runtime_s = started.elapsed().as_secs_f64();
+    if let Some(path) = &options.json {
+        diagnosis.outputs.push(path.display().to_string());
+        let text = serde_json::to_string_pretty(&diagnosis)
+            .map_err(|e| AppError::Output(e.to_string()))?;
+        crate::io::write_atomically(path, text.as_bytes())?;
+    }
+    Ok(diagnosis)
+}
+
+/// The figures of the sampled fits, `model.toml`, `fit.json` and the missing torque in `out`.
+fn write_figures(
+    problem: &Problem,
+    diagnosis: &mut Diagnosis,
+    out: &std::path::Path,
+) -> Result<(), AppError> {
+    std::fs::create_dir_all(out)?;
+    let k = diagnosis.discrepancy_degree;
+    let mut outputs = Vec::new();
+    if !diagnosis.fits.is_empty() {
+        let selected = diagnosis.selected_set.join(" + ");
+        for stage_fit in diagnosis.fits.iter_mut() {
+            let (stage, fit) = (stage_fit.stage, &mut stage_fit.fit);
+            for r in 0..fit.posterior.n_records() {
+                let p = posterior_predictive(&mut fit.posterior, &fit.run.chains, r)?;
+                let suffix = if problem.recordings.len() > 1 {
+                    format!("-{}", r + 1)
+                } else {
+                    String::new()
+                };
+                let path = if stage.is_bm2() {
+                    let path = out.join(format!("discrepancy-{}{suffix}.png", stage.name()));
+                    let when = if stage.is_after() { "after" } else { "before" };
+                    plot_discrepancy(&path, &format!("δ {when} (BM2, K = {k})"), &p, None)?;
+                    path
+                } else {
+                    let path = out.join(format!("fit-{}{suffix}.png", stage.name()));
+                    let title = if stage == FitStage::Before {
+                        "the model as given (BM1)".to_string()
+                    } else {
+                        format!("with {selected} (BM1)")
+                    };
+                    plot_predictive(&path, &title, &p)?;
+                    path
+                };
+                outputs.push(path.display().to_string());
+            }
+        }
+        if let Some(model) = &diagnosis.amended_model {
+            let path = out.join("model.toml");
+            write_model_file(&path, model)?;
+            outputs.push(path.display().to_string());
+        }
+        let fits_json = serde_json::json!({
+            "before": diagnosis.fit_before,
+            "after": diagnosis.fit_after,
+            "convergence": diagnosis.convergence,
+        });
+        let path = out.join("fit.json");
+        crate::io::write_atomically(
+            &path,
+            serde_json::to_string_pretty(&fits_json)
+                .map_err(|e| AppError::Output(e.to_string()))?
+                .as_bytes(),
+        )?;
+        outputs.push(path.display().to_string());
+    }
+    if !diagnosis.missing_torque.is_empty() {
+        let path = out.join("missing-torque.png");
+        let plot = crate::plot::MissingTorquePlot {
+            title: "the torque the model misses, against speed".into(),
+            speed_unit: problem.model.base.unit("rad/s").into(),
+            torque_unit: problem.model.base.unit("N·m").into(),
+            curves: diagnosis.missing_torque.clone(),
+        };
+        crate::plot::missing_torque(&path, &plot).map_err(|e| AppError::Output(e.to_string()))?;
+        outputs.push(path.display().to_string());
+    }
+    diagnosis.outputs.extend(outputs);
+    Ok(())
+}
+
+fn unit_of(name: &str) -> &'static str {
+    let Some((term, key)) = name.split_once('.') else {
+        return if name == "R" { "Ω" } else { "" };
+    };
+    Term::named(term)
+        .and_then(|t| t.params().iter().find(|p| p.key == key).map(|p| p.unit))
+        .unwrap_or("")
+}
+
+/// Four significant figures, in fixed notation where that reads well.
+fn sig(v: f64) -> String {
+    if v == 0.0 || (1e-3..1e4).contains(&v.abs()) {
+        format!("{v:.4}")
+    } else {
+        format!("{v:.3e}")
+    }
+}
+
+/// The human summary.
+pub fn format_diagnosis(d: &Diagnosis) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "ranking (score: log L − ½·d·ln N against none, nats):");
+    for e in &d.ranking {
+        let _ = write!(
+            s,
+            "  {:<20} {:>+10.2}   Laplace (default priors) {:>+10.2}",
+            e.effect, e.score, e.log_evidence_laplace
+        );
+        match &e.coincides_with_input_step {
+            Some(c) => {
+                let _ = writeln!(
+                    s,
+                    "   at the {} step at {:.4} s: not selected",
+                    c.input_step.input, c.input_step.time
+                );
+            }
+            None => s.push('\n'),
+        }
+    }
+    if d.selected_set.is_empty() {
+        let _ = writeln!(
+            s,
+            "no candidate beats the model as it is by more than {} nats: nothing missing found",
+            d.threshold
+        );
+    } else {
+        let _ = writeln!(s, "the model lacks {}", d.selected_set.join(" + "));
+        if d.fit_after.is_none() {
+            let _ = writeln!(s, "its MAP:");
+            for (name, value) in &d.selected_params {
+                let unit = d
+                    .units
+                    .get(name)
+                    .map_or_else(|| unit_of(name), String::as_str);
+                let _ = writeln!(s, "  {name} = {value:.5e} {unit}");
+            }
+        }
+        if let Some(after) = &d.fit_after {
+            for (name, mean) in &after.params_mean {
+                let ci = after.params_95.get(name).copied().unwrap_or([f64::NAN; 2]);
+                let _ = writeln!(
+                    s,
+                    "  {name} = {mean:.5e} {} [95%: {:.5e}, {:.5e}]",
+                    d.units
+                        .get(name)
+                        .map_or_else(|| unit_of(name), String::as_str),
+                    ci[0],
+                    ci[1]
+                );
+            }
+        }
+    }
+    if let (Some(b), Some(a)) = (&d.fit_before, &d.fit_after) {
+        let _ = writeln!(
+            s,
+            "log likelihood {:.1} → {:.1} ({:+.1} nats)",
+            b.log_likelihood,
+            a.log_likelihood,
+            a.log_likelihood - b.log_likelihood
+        );
+        for (ch, sb) in &b.sigma {
+            let sa = a.sigma.get(ch).copied().unwrap_or(f64::NAN);
+            let wb = &b.whiteness[ch];
+            let wa = &a.whiteness[ch];
+            let _ = writeln!(
+                s,
+                "σ_{ch} {} → {}; Ljung–Box p {:.2e} → {:.2e}",
+                sig(*sb),
+                sig(sa),
+                wb.p_value,
+                wa.p_value
+            );
+        }
+    }
+    for [a, b] in &d.tied_pairs {
+        let _ = writeln!(
+            s,
+            "{a} and {b} cannot be told apart on these records: add a {} record",
+            d.tie_experiments
+                .get(&format!("{a}/{b}"))
+                .map(String::as_str)
+                .unwrap_or("different")
+        );
+    }
+    for t in &d.ties {
+        let _ = writeln!(
+            s,
+            "cannot be told apart from {t} on this recording: add a {} input",
+            d.tie_experiments
+                .get(t)
+                .map(String::as_str)
+                .unwrap_or("different")
+        );
+    }
+    for m in &d.mismatch {
+        let _ = writeln!(
+            s,
+            "mismatch before: {} from {:.4} s to {:.4} s (|δ| up to {:.2} σ)",
+            m.channel, m.t_start, m.t_end, m.max_over_sigma
+        );
+    }
+    for n in &d.notes {
+        let _ = writeln!(s, "note: {n}");
+    }
+    let _ = writeln!(
+        s,
+        "runtime {:.1} s (ranking {:.1} s, selection {:.1} s)",
+        d.runtime_s, d.ranking_s, d.selection_s
+    );
+    s
+}

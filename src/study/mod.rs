@@ -1,0 +1,15 @@
+//! The problem a user poses: recordings plus the model they believe (from files, from memory
+//! or from the paper's synthetic set-up) → the posterior of BM1/BM2 with the noise-prior policy
+//! of its base; what a fitted model predicts; the inputs of synthetic experiments; and the
+//! concealed-physics cases made to test the discovery.
+
+pub mod cases;
+mod inputs;
+mod predict;
+pub mod predictive;
+mod problem;
+
+pub use inputs::InputProfile;
+pub use predict::{ChannelResidual, RecordPrediction, predict_records, residuals};
+pub use predictive::{ChannelPredictive, Predictive, posterior_predictive};
+pub use problem::{BOUNDED_STARTS, Problem, Reference, recording_from};
