@@ -24,18 +24,28 @@
 //!
 //! ```
 //! use motorcal::discover::{DiscoverSettings, discover};
+//! use motorcal::study::cases::{CaseOptions, make_case};
 //! use motorcal::study::{InputProfile, Problem};
 //!
-//! // The paper's synthetic recording and nominal model (c_g 10% low): which term is missing?
-//! let problem = Problem::paper(20180823).unwrap();
-//! let settings = DiscoverSettings {
-//!     candidates: Some(vec!["torque_constant".into(), "load_torque".into()]),
-//!     rank_only: true,
-//!     ..DiscoverSettings::default()
+//! // A start-up with Coulomb friction three noise σ strong, simulated in memory.
+//! let case = make_case(&CaseOptions {
+//!     effects: vec!["coulomb_friction".into()],
+//!     magnitude: Some(3.0),
+//!     input: InputProfile::Constant,
+//!     seed: 2026,
+//!     conceal: false,
+//! })?;
+//! let problem = Problem {
+//!     label: "in memory".into(),
+//!     recordings: vec![case.recording],
+//!     model: case.nominal,
+//!     reference: None,
 //! };
-//! let diagnosis = discover(&problem, &settings).unwrap();
-//! assert_eq!(diagnosis.selected, "torque_constant");
-//! # let _ = InputProfile::Constant;
+//! let mut settings = DiscoverSettings { rank_only: true, ..DiscoverSettings::default() };
+//! settings.run.quiet = true;
+//! let diagnosis = discover(&problem, &settings)?;
+//! assert_eq!(diagnosis.selected, "coulomb_friction");
+//! # Ok::<(), motorcal::error::Error>(())
 //! ```
 
 mod candidate;
