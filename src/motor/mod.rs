@@ -7,16 +7,18 @@
 //! vector (the base's states, then each term's), and the channels it measures. A term is an
 //! addition to these vectors, never a copy of the motor.
 
+mod balance;
 pub mod closed_form;
 mod drive;
 mod input;
 mod parameters;
 pub mod terms;
 
+pub use balance::{Balance, Coefficients, Site, torque_balance, voltage_balance};
 pub use drive::{DriveSettings, SampledDrive};
 pub use input::VoltageInput;
 pub use parameters::{MotorParam, MotorParameters};
-pub use terms::{Balance, Coefficients, Magnitudes, PRIOR_SHARE, Site, Term};
+pub use terms::{Magnitudes, PRIOR_SHARE, Term};
 
 use num_dual::DualNum;
 
@@ -282,43 +284,6 @@ impl MotorModel {
         drive::simulate(self, drive, p, out)
     }
 
-    /// The torque balance of the mechanical equation at the model's values, from measured
-    /// series: c_g·u − d·ω + Σ term torques − J·ω̇ at every sample, i.e. the torque the model
-    /// misses there (the inverse-model residual; u is the current or controller output).
-    pub fn missing_torque(
-        &self,
-        times: &[f64],
-        input: &[f64],
-        speed: &[f64],
-        acceleration: &[f64],
-    ) -> Vec<f64> {
-        let p = self.parameter_values();
-        let c = self.coefficients(&p);
-        (0..times.len())
-            .map(|i| {
-                let mut balance = Balance {
-                    resistance: c.resistance,
-                    torque_constant: c.torque_constant,
-                    voltage: 0.0,
-                    torque: 0.0,
-                };
-                for (k, term) in self.terms.iter().enumerate() {
-                    let site = Site {
-                        t: times[i],
-                        segment_start: times[i],
-                        current: input[i],
-                        speed: speed[i],
-                        params: &p[self.param_offsets[k]..self.param_offsets[k + 1]],
-                        states: &[],
-                    };
-                    term.term.contribute(&site, &mut balance);
-                }
-                balance.torque_constant * input[i] - c.viscous_friction * speed[i] + balance.torque
-                    - acceleration[i] / c.inverse_inertia
-            })
-            .collect()
-    }
-
     /// The scales the default priors are drawn to, for a recording of the given length.
     pub fn magnitudes(&self, duration: f64) -> Magnitudes {
         let m = &self.nominal;
@@ -580,9 +545,7 @@ pub struct MotorSystem<'a, D> {
 }
 
 impl<D: Scalar> MotorSystem<'_, D> {
-    /// Equations (3)–(4) with every term's contribution: L dI/dt = U − R I − c_m ω + Σ voltage
-    /// and J dω/dt = c_g I − d ω + Σ torque (the load torque opposes motion; the paper writes
-    /// +T_L but only ever uses T_L = 0).
+    /// Equations (3)–(4) with every term's contribution.
     fn with_terms(&self, t: f64, segment: usize, voltage: D, y: &[D], dy: &mut [D]) {
         let model = self.model;
         let c = &self.coefficients;
@@ -599,27 +562,10 @@ impl<D: Scalar> MotorSystem<'_, D> {
             params: &self.p[model.param_offsets[k]..model.param_offsets[k + 1]],
             states: &y[model.state_offsets[k]..model.state_offsets[k + 1]],
         };
-        let mut balance = Balance {
-            resistance: c.resistance,
-            torque_constant: c.torque_constant,
-            voltage: D::from(0.0),
-            torque: D::from(0.0),
-        };
-        for (k, active) in model.terms.iter().enumerate() {
-            active.term.contribute(&site(k), &mut balance);
-        }
-        let electrical =
-            voltage - balance.resistance * current - c.back_emf_constant * speed + balance.voltage;
-        let mechanical =
-            balance.torque_constant * current - c.viscous_friction * speed + balance.torque;
-        dy[0] = electrical * c.inverse_inductance;
-        dy[1] = mechanical * c.inverse_inertia;
-        for (k, active) in model.terms.iter().enumerate() {
-            let states = model.state_offsets[k]..model.state_offsets[k + 1];
-            if !states.is_empty() {
-                active.term.derivatives(&site(k), &balance, &mut dy[states]);
-            }
-        }
+        let balance = model.balance(c, &site);
+        dy[0] = voltage_balance(c, Some(&balance), voltage, current, speed) * c.inverse_inductance;
+        dy[1] = torque_balance(c, Some(&balance), current, speed) * c.inverse_inertia;
+        model.term_derivatives(&site, &balance, dy);
     }
 }
 
@@ -680,9 +626,7 @@ impl<D: Scalar> OdeSystem<D> for PlainMotorSystem<'_, D> {
         let voltage = self.0.voltage(segment);
         let c = &self.0.coefficients;
         let (current, speed) = (y[0], y[1]);
-        let electrical = voltage - c.resistance * current - c.back_emf_constant * speed;
-        let mechanical = c.torque_constant * current - c.viscous_friction * speed;
-        dy[0] = electrical * c.inverse_inductance;
-        dy[1] = mechanical * c.inverse_inertia;
+        dy[0] = voltage_balance(c, None, voltage, current, speed) * c.inverse_inductance;
+        dy[1] = torque_balance(c, None, current, speed) * c.inverse_inertia;
     }
 }

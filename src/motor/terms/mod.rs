@@ -38,6 +38,7 @@ pub use voltage_drop::VoltageDrop;
 use crate::parameter::{Prior, Support};
 
 use super::Scalar;
+pub use super::balance::{Balance, Coefficients, Site};
 
 /// The scales of a model, from its nominal values and the record's length: what a "small" or
 /// "large" value of a term's parameter means for this machine. A default prior puts one
@@ -86,40 +87,6 @@ pub struct TermSetting {
 pub struct TermState {
     pub name: &'static str,
     pub initial: f64,
-}
-
-/// The parameters as the right-hand side uses them, extracted once per solve (the divisions by
-/// L and J become multiplications), after the terms that rescale a constant have acted.
-#[derive(Clone, Copy, Debug)]
-pub struct Coefficients<D> {
-    pub resistance: D,
-    pub back_emf_constant: D,
-    pub torque_constant: D,
-    pub viscous_friction: D,
-    pub inverse_inductance: D,
-    pub inverse_inertia: D,
-}
-
-/// The two balances at one instant, as terms amend them: L dI/dt = U − R·I − c_m·ω + voltage
-/// and J dω/dt = c_g·I − d·ω + torque.
-#[derive(Clone, Copy, Debug)]
-pub struct Balance<D> {
-    pub resistance: D,
-    pub torque_constant: D,
-    pub voltage: D,
-    pub torque: D,
-}
-
-/// Where a term is evaluated: the state, its own parameters and its own states.
-pub struct Site<'a, D> {
-    pub t: f64,
-    /// Start of the interval between breakpoints being integrated: a hard step at a breakpoint
-    /// is decided by it, since the step that ends on the breakpoint still sees the old side.
-    pub segment_start: f64,
-    pub current: D,
-    pub speed: D,
-    pub params: &'a [D],
-    pub states: &'a [D],
 }
 
 /// One physics term. Hooks left at their defaults contribute nothing.
