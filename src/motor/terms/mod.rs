@@ -5,35 +5,8 @@
 //! Every term is one file of the same shape: a struct holding its settings and an impl of
 //! [`PhysicsTerm`], overriding only the hooks it contributes to. The right-hand side is generic
 //! over dual numbers, which a trait object cannot carry, so [`Term`] dispatches by `match`; the
-//! macro below writes that enum and its dispatch once from the list of terms.
-
-mod armature_reaction;
-mod asymmetric_friction;
-mod back_emf_constant;
-mod coulomb_friction;
-mod current_offset;
-mod load_step;
-mod load_torque;
-mod quadratic_drag;
-mod resistance_heating;
-mod speed_gain;
-mod torque_constant;
-mod viscous_friction;
-mod voltage_drop;
-
-pub use armature_reaction::ArmatureReaction;
-pub use asymmetric_friction::AsymmetricFriction;
-pub use back_emf_constant::BackEmfConstant;
-pub use coulomb_friction::CoulombFriction;
-pub use current_offset::CurrentOffset;
-pub use load_step::LoadStep;
-pub use load_torque::LoadTorque;
-pub use quadratic_drag::QuadraticDrag;
-pub use resistance_heating::ResistanceHeating;
-pub use speed_gain::SpeedGain;
-pub use torque_constant::TorqueConstant;
-pub use viscous_friction::ViscousFriction;
-pub use voltage_drop::VoltageDrop;
+//! `terms!` list at the end of this file names each term once (`file::Struct`), and the macro
+//! writes from it the module lines, the re-exports, that enum and its dispatch.
 
 use crate::parameter::{Prior, Support};
 
@@ -187,8 +160,16 @@ pub(crate) fn positive(_: &Magnitudes) -> Support {
     Support::Positive
 }
 
+// rustfmt does not follow modules a macro declares (rust-lang/rustfmt#3253), so `cargo fmt`
+// leaves the term files as they are: format them with
+// `rustfmt --edition 2024 src/motor/terms/*.rs`.
 macro_rules! terms {
-    ($($variant:ident),* $(,)?) => {
+    ($($module:ident::$variant:ident),* $(,)?) => {
+        $(
+            mod $module;
+            pub use $module::$variant;
+        )*
+
         /// An active physics term with its settings.
         #[derive(Clone, Debug, PartialEq)]
         pub enum Term {
@@ -289,19 +270,19 @@ macro_rules! terms {
 }
 
 terms!(
-    TorqueConstant,
-    BackEmfConstant,
-    ViscousFriction,
-    CoulombFriction,
-    QuadraticDrag,
-    LoadTorque,
-    LoadStep,
-    VoltageDrop,
-    ResistanceHeating,
-    ArmatureReaction,
-    CurrentOffset,
-    SpeedGain,
-    AsymmetricFriction,
+    torque_constant::TorqueConstant,
+    back_emf_constant::BackEmfConstant,
+    viscous_friction::ViscousFriction,
+    coulomb_friction::CoulombFriction,
+    quadratic_drag::QuadraticDrag,
+    load_torque::LoadTorque,
+    load_step::LoadStep,
+    voltage_drop::VoltageDrop,
+    resistance_heating::ResistanceHeating,
+    armature_reaction::ArmatureReaction,
+    current_offset::CurrentOffset,
+    speed_gain::SpeedGain,
+    asymmetric_friction::AsymmetricFriction,
 );
 
 impl Term {
