@@ -9,7 +9,7 @@
 //! passes `None`, not a zero sum: adding a zero costs a dual number a full addition, and the
 //! plain solve is the hot path.
 
-use super::{MotorModel, Scalar};
+use super::{MotorModel, MotorParam, Scalar};
 
 /// The parameters as the right-hand side uses them, extracted once per solve (the divisions by
 /// L and J become multiplications), after the terms that rescale a constant have acted.
@@ -74,6 +74,19 @@ pub fn torque_balance<D: Scalar>(
 }
 
 impl MotorModel {
+    /// The constants the right-hand side uses at a parameter vector, after the terms that
+    /// rescale one (torque constant, extra viscous friction) have acted: once per solve.
+    pub fn coefficients<D: Scalar>(&self, p: &[D]) -> Coefficients<D> {
+        let mut coefficients = base_coefficients(p);
+        for (k, t) in self.terms.iter().enumerate() {
+            t.term.adjust(
+                &p[self.param_offsets[k]..self.param_offsets[k + 1]],
+                &mut coefficients,
+            );
+        }
+        coefficients
+    }
+
     /// Every term's contribution at one instant; `site(k)` is where term k is evaluated.
     #[inline]
     pub(super) fn balance<'a, D: Scalar + 'a>(
@@ -136,5 +149,18 @@ impl MotorModel {
                     - acceleration[i] / c.inverse_inertia
             })
             .collect()
+    }
+}
+
+/// The base's constants as the right-hand side reads them, before a term rescales one.
+fn base_coefficients<D: Scalar>(p: &[D]) -> Coefficients<D> {
+    use MotorParam::*;
+    Coefficients {
+        resistance: p[Resistance as usize],
+        back_emf_constant: p[BackEmfConstant as usize],
+        torque_constant: p[TorqueConstant as usize],
+        viscous_friction: p[ViscousFriction as usize],
+        inverse_inductance: p[Inductance as usize].recip(),
+        inverse_inertia: p[Inertia as usize].recip(),
     }
 }

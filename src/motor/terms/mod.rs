@@ -8,32 +8,13 @@
 //! `terms!` list at the end of this file names each term once (`file::Struct`), and the macro
 //! writes from it the module lines, the re-exports, that enum and its dispatch.
 
+use super::Scalar;
 use crate::parameter::{Prior, Support};
 
-use super::Scalar;
+// Where the terms' files find what they amend and what their priors are scaled by; public, as
+// these paths were before the balances and magnitudes had files of their own.
 pub use super::balance::{Balance, Coefficients, Site};
-
-/// The scales of a model, from its nominal values and the record's length: what a "small" or
-/// "large" value of a term's parameter means for this machine. A default prior puts one
-/// standard deviation at an effect of a tenth of the scale it acts on.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Magnitudes {
-    /// The largest supply voltage |U| [V].
-    pub voltage: f64,
-    /// Stall current U/R [A].
-    pub current: f64,
-    /// No-load speed U/c_m [rad/s].
-    pub speed: f64,
-    /// Stall torque c_g·U/R [N·m].
-    pub torque: f64,
-    /// Heat of a start-up: (U²/R) times the mechanical time constant J·R/(c_g·c_m) [J].
-    pub energy: f64,
-    /// Length of the recording [s].
-    pub duration: f64,
-}
-
-/// The share of a magnitude one prior standard deviation stands for.
-pub const PRIOR_SHARE: f64 = 0.1;
+pub use super::magnitudes::{Magnitudes, PRIOR_SHARE};
 
 /// A parameter a term adds.
 pub struct TermParam {
