@@ -16,7 +16,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::terms::{Balance, Site};
+use super::balance::{Coefficients, Site, torque_balance};
 use super::{Base, MotorModel, MotorParam, Scalar};
 use crate::ode::{HeldInputSystem, OdeError, SolverStats, solve_sampled};
 
@@ -111,10 +111,7 @@ impl SampledDrive {
 struct Mechanics<'a, D> {
     model: &'a MotorModel,
     p: &'a [D],
-    /// c_g after the terms that rescale it, d, 1/J.
-    torque_constant: D,
-    viscous_friction: D,
-    inverse_inertia: D,
+    coefficients: Coefficients<D>,
 }
 
 impl<D: Scalar> HeldInputSystem<D> for Mechanics<'_, D> {
@@ -124,6 +121,7 @@ impl<D: Scalar> HeldInputSystem<D> for Mechanics<'_, D> {
 
     fn rhs(&self, t: f64, y: &[D], input: D, dy: &mut [D]) {
         let model = self.model;
+        let c = &self.coefficients;
         let speed = y[1];
         let site = |k: usize| Site {
             t,
@@ -133,24 +131,10 @@ impl<D: Scalar> HeldInputSystem<D> for Mechanics<'_, D> {
             params: &self.p[model.param_offsets[k]..model.param_offsets[k + 1]],
             states: &y[model.state_offsets[k]..model.state_offsets[k + 1]],
         };
-        let mut balance = Balance {
-            resistance: D::from(0.0),
-            torque_constant: self.torque_constant,
-            voltage: D::from(0.0),
-            torque: D::from(0.0),
-        };
-        for (k, active) in model.terms.iter().enumerate() {
-            active.term.contribute(&site(k), &mut balance);
-        }
+        let balance = model.balance(c, &site);
         dy[0] = speed;
-        dy[1] = (balance.torque_constant * input - self.viscous_friction * speed + balance.torque)
-            * self.inverse_inertia;
-        for (k, active) in model.terms.iter().enumerate() {
-            let states = model.state_offsets[k]..model.state_offsets[k + 1];
-            if !states.is_empty() {
-                active.term.derivatives(&site(k), &balance, &mut dy[states]);
-            }
-        }
+        dy[1] = torque_balance(c, Some(&balance), input, speed) * c.inverse_inertia;
+        model.term_derivatives(&site, &balance, dy);
     }
 }
 
@@ -161,13 +145,10 @@ pub(super) fn simulate<D: Scalar>(
     p: &[D],
     out: &mut [D],
 ) -> Result<SolverStats, OdeError> {
-    let coefficients = model.coefficients(p);
     let system = Mechanics {
         model,
         p,
-        torque_constant: coefficients.torque_constant,
-        viscous_friction: coefficients.viscous_friction,
-        inverse_inertia: coefficients.inverse_inertia,
+        coefficients: model.coefficients(p),
     };
     let m = drive.times.len();
     let mut y0 = vec![D::from(0.0); model.n_states()];

@@ -5,61 +5,16 @@
 //! Every term is one file of the same shape: a struct holding its settings and an impl of
 //! [`PhysicsTerm`], overriding only the hooks it contributes to. The right-hand side is generic
 //! over dual numbers, which a trait object cannot carry, so [`Term`] dispatches by `match`; the
-//! macro below writes that enum and its dispatch once from the list of terms.
-
-mod armature_reaction;
-mod asymmetric_friction;
-mod back_emf_constant;
-mod coulomb_friction;
-mod current_offset;
-mod load_step;
-mod load_torque;
-mod quadratic_drag;
-mod resistance_heating;
-mod speed_gain;
-mod torque_constant;
-mod viscous_friction;
-mod voltage_drop;
-
-pub use armature_reaction::ArmatureReaction;
-pub use asymmetric_friction::AsymmetricFriction;
-pub use back_emf_constant::BackEmfConstant;
-pub use coulomb_friction::CoulombFriction;
-pub use current_offset::CurrentOffset;
-pub use load_step::LoadStep;
-pub use load_torque::LoadTorque;
-pub use quadratic_drag::QuadraticDrag;
-pub use resistance_heating::ResistanceHeating;
-pub use speed_gain::SpeedGain;
-pub use torque_constant::TorqueConstant;
-pub use viscous_friction::ViscousFriction;
-pub use voltage_drop::VoltageDrop;
-
-use crate::parameter::{Prior, Support};
+//! `terms!` list at the end of this file names each term once (`file::Struct`), and the macro
+//! writes from it the module lines, the re-exports, that enum and its dispatch.
 
 use super::Scalar;
+use crate::parameter::{Prior, Support};
 
-/// The scales of a model, from its nominal values and the record's length: what a "small" or
-/// "large" value of a term's parameter means for this machine. A default prior puts one
-/// standard deviation at an effect of a tenth of the scale it acts on.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Magnitudes {
-    /// The largest supply voltage |U| [V].
-    pub voltage: f64,
-    /// Stall current U/R [A].
-    pub current: f64,
-    /// No-load speed U/c_m [rad/s].
-    pub speed: f64,
-    /// Stall torque c_g·U/R [N·m].
-    pub torque: f64,
-    /// Heat of a start-up: (U²/R) times the mechanical time constant J·R/(c_g·c_m) [J].
-    pub energy: f64,
-    /// Length of the recording [s].
-    pub duration: f64,
-}
-
-/// The share of a magnitude one prior standard deviation stands for.
-pub const PRIOR_SHARE: f64 = 0.1;
+// Where the terms' files find what they amend and what their priors are scaled by; public, as
+// these paths were before the balances and magnitudes had files of their own.
+pub use super::balance::{Balance, Coefficients, Site};
+pub use super::magnitudes::{Magnitudes, PRIOR_SHARE};
 
 /// A parameter a term adds.
 pub struct TermParam {
@@ -86,40 +41,6 @@ pub struct TermSetting {
 pub struct TermState {
     pub name: &'static str,
     pub initial: f64,
-}
-
-/// The parameters as the right-hand side uses them, extracted once per solve (the divisions by
-/// L and J become multiplications), after the terms that rescale a constant have acted.
-#[derive(Clone, Copy, Debug)]
-pub struct Coefficients<D> {
-    pub resistance: D,
-    pub back_emf_constant: D,
-    pub torque_constant: D,
-    pub viscous_friction: D,
-    pub inverse_inductance: D,
-    pub inverse_inertia: D,
-}
-
-/// The two balances at one instant, as terms amend them: L dI/dt = U − R·I − c_m·ω + voltage
-/// and J dω/dt = c_g·I − d·ω + torque.
-#[derive(Clone, Copy, Debug)]
-pub struct Balance<D> {
-    pub resistance: D,
-    pub torque_constant: D,
-    pub voltage: D,
-    pub torque: D,
-}
-
-/// Where a term is evaluated: the state, its own parameters and its own states.
-pub struct Site<'a, D> {
-    pub t: f64,
-    /// Start of the interval between breakpoints being integrated: a hard step at a breakpoint
-    /// is decided by it, since the step that ends on the breakpoint still sees the old side.
-    pub segment_start: f64,
-    pub current: D,
-    pub speed: D,
-    pub params: &'a [D],
-    pub states: &'a [D],
 }
 
 /// One physics term. Hooks left at their defaults contribute nothing.
@@ -220,8 +141,16 @@ pub(crate) fn positive(_: &Magnitudes) -> Support {
     Support::Positive
 }
 
+// rustfmt does not follow modules a macro declares (rust-lang/rustfmt#3253), so `cargo fmt`
+// leaves the term files as they are: format them with
+// `rustfmt --edition 2024 src/motor/terms/*.rs`.
 macro_rules! terms {
-    ($($variant:ident),* $(,)?) => {
+    ($($module:ident::$variant:ident),* $(,)?) => {
+        $(
+            mod $module;
+            pub use $module::$variant;
+        )*
+
         /// An active physics term with its settings.
         #[derive(Clone, Debug, PartialEq)]
         pub enum Term {
@@ -322,19 +251,19 @@ macro_rules! terms {
 }
 
 terms!(
-    TorqueConstant,
-    BackEmfConstant,
-    ViscousFriction,
-    CoulombFriction,
-    QuadraticDrag,
-    LoadTorque,
-    LoadStep,
-    VoltageDrop,
-    ResistanceHeating,
-    ArmatureReaction,
-    CurrentOffset,
-    SpeedGain,
-    AsymmetricFriction,
+    torque_constant::TorqueConstant,
+    back_emf_constant::BackEmfConstant,
+    viscous_friction::ViscousFriction,
+    coulomb_friction::CoulombFriction,
+    quadratic_drag::QuadraticDrag,
+    load_torque::LoadTorque,
+    load_step::LoadStep,
+    voltage_drop::VoltageDrop,
+    resistance_heating::ResistanceHeating,
+    armature_reaction::ArmatureReaction,
+    current_offset::CurrentOffset,
+    speed_gain::SpeedGain,
+    asymmetric_friction::AsymmetricFriction,
 );
 
 impl Term {
