@@ -34,6 +34,7 @@ use crate::sampler::{Adaptation, ChainOutput, ChainSettings, Kernel, run_chains}
 use crate::error::{Error, InputError};
 
 pub mod cost;
+pub use crate::sampler::PhaseCost;
 pub use cost::{RunCost, ratio_2sf};
 
 /// What the pipeline can fit: a log density with a gradient and a Gauss–Newton metric that
@@ -230,26 +231,13 @@ pub struct RunOutput {
     /// Wall time of the whole run: MAP, initial points, chains, diagnostics.
     pub wall_seconds: f64,
     /// The MAP search and the initial points drawn around it, on the calling thread.
-    pub map_wall_seconds: f64,
-    pub map_cpu_seconds: f64,
+    pub map: PhaseCost,
     /// Warm-up and sampling, each summed over chains, wall time and CPU time alike: the
     /// phases then add up to the chains' whole cost whatever the thread count (a maximum over
     /// chains would not, and with fewer threads than chains a chain's wall time includes
     /// waiting for a core, which its CPU time does not).
-    pub warmup_wall_seconds: f64,
-    pub warmup_cpu_seconds: f64,
-    pub sampling_wall_seconds: f64,
-    pub sampling_cpu_seconds: f64,
-    /// Evaluations of each phase, summed over chains; a Fisher metric is a "metric".
-    pub map_density_evaluations: u64,
-    pub map_gradient_evaluations: u64,
-    pub map_metric_evaluations: u64,
-    pub warmup_density_evaluations: u64,
-    pub warmup_gradient_evaluations: u64,
-    pub warmup_metric_evaluations: u64,
-    pub sampling_density_evaluations: u64,
-    pub sampling_gradient_evaluations: u64,
-    pub sampling_metric_evaluations: u64,
+    pub warmup: PhaseCost,
+    pub sampling: PhaseCost,
     pub divergences: usize,
     pub map_log_density: f64,
     pub log_evidence_laplace: f64,
@@ -396,21 +384,10 @@ pub fn finish_run(
         max_rhat,
         min_ess_bulk,
         wall_seconds: started.elapsed().as_secs_f64(),
-        map_wall_seconds: 0.0,
-        map_cpu_seconds: 0.0,
-        warmup_wall_seconds: chains.iter().map(|c| c.warmup_wall_seconds).sum(),
-        warmup_cpu_seconds: chains.iter().map(|c| c.warmup_cpu_seconds).sum(),
-        sampling_wall_seconds: chains.iter().map(|c| c.sampling_wall_seconds).sum(),
-        sampling_cpu_seconds: chains.iter().map(|c| c.sampling_cpu_seconds).sum(),
-        map_density_evaluations: 0,
-        map_gradient_evaluations: 0,
-        map_metric_evaluations: 0,
-        warmup_density_evaluations: chains.iter().map(|c| c.warmup_density_evaluations).sum(),
-        warmup_gradient_evaluations: chains.iter().map(|c| c.warmup_gradient_evaluations).sum(),
-        warmup_metric_evaluations: chains.iter().map(|c| c.warmup_metric_evaluations).sum(),
-        sampling_density_evaluations: chains.iter().map(|c| c.sampling_density_evaluations).sum(),
-        sampling_gradient_evaluations: chains.iter().map(|c| c.sampling_gradient_evaluations).sum(),
-        sampling_metric_evaluations: chains.iter().map(|c| c.sampling_metric_evaluations).sum(),
+        // The MAP is not a chain's: the caller that ran one fills it in.
+        map: PhaseCost::default(),
+        warmup: chains.iter().map(|c| c.warmup).sum(),
+        sampling: chains.iter().map(|c| c.sampling).sum(),
         divergences: chains.iter().map(|c| c.divergences).sum(),
         map_log_density: map.log_density,
         log_evidence_laplace: map.log_evidence_laplace,
@@ -439,15 +416,11 @@ pub fn run_sampler<P: Fittable>(
         settings.init_dispersion,
         settings.seed,
     )?;
-    let map_time = map_watch.elapsed();
+    let map_cost = PhaseCost::counted(map_watch.elapsed(), &counted);
     let label = format!("{label} {}", settings.sampler.name());
     let chains = dispatch(posterior, &map, &inits, settings, &label)?;
     Ok(RunOutput {
-        map_wall_seconds: map_time.wall_seconds,
-        map_cpu_seconds: map_time.cpu_seconds,
-        map_density_evaluations: counted.density_evaluations,
-        map_gradient_evaluations: counted.gradient_evaluations,
-        map_metric_evaluations: counted.metric_evaluations,
+        map: map_cost,
         ..finish_run(settings.sampler.name(), chains, &map, started)
     })
 }
