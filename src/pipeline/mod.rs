@@ -43,7 +43,7 @@ pub trait Fittable: FisherMetric + StartingPoint + Clone + Send + Sync {}
 impl<P: FisherMetric + StartingPoint + Clone + Send + Sync> Fittable for P {}
 
 /// The samplers a user can pick.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum SamplerKind {
     /// The paper's Metropolis: one random-walk step per variable in turn, tuned as PyMC3 did.
@@ -108,11 +108,18 @@ impl SamplerKind {
     ];
 }
 
+/// A sampler by its [`SamplerKind::name`].
+impl std::str::FromStr for SamplerKind {
+    type Err = Error;
+
+    fn from_str(text: &str) -> Result<Self, Error> {
+        crate::error::parse_name("sampler", text, &Self::ALL, Self::name)
+    }
+}
+
 /// How HMC and NUTS tune their metric in warm-up. Both start from the Laplace covariance (the
 /// inverse MAP Hessian, or its diagonal).
-#[derive(
-    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize, clap::ValueEnum,
-)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum MetricAdaptation {
     /// Keep the Laplace covariance; warm-up tunes the step size alone. The calibration
@@ -159,6 +166,17 @@ impl MetricAdaptation {
             MetricAdaptation::Laplace => "laplace",
             MetricAdaptation::Windows => "windows",
         }
+    }
+
+    pub const ALL: [MetricAdaptation; 2] = [MetricAdaptation::Laplace, MetricAdaptation::Windows];
+}
+
+/// A metric adaptation by its [`MetricAdaptation::name`].
+impl std::str::FromStr for MetricAdaptation {
+    type Err = Error;
+
+    fn from_str(text: &str) -> Result<Self, Error> {
+        crate::error::parse_name("metric_adaptation", text, &Self::ALL, Self::name)
     }
 }
 
