@@ -19,6 +19,7 @@ pub mod metric;
 pub mod metropolis;
 pub mod nuts;
 pub mod targets;
+pub mod welford;
 
 pub use cost::PhaseCost;
 pub use driver::{ChainOutput, ChainSettings, DrawRecord, run_chain, run_chains};
