@@ -67,17 +67,17 @@ impl RunStats {
         let chain_seconds = run
             .chains
             .iter()
-            .map(|c| c.warmup_cpu_seconds + c.sampling_cpu_seconds)
+            .map(|c| c.warmup.cpu_seconds + c.sampling.cpu_seconds)
             .sum();
-        let sampling_seconds = run.chains.iter().map(|c| c.sampling_cpu_seconds).sum();
+        let sampling_seconds = run.chains.iter().map(|c| c.sampling.cpu_seconds).sum();
         let evaluations = run
             .chains
             .iter()
             .map(|c| {
                 let n = if uses_gradient {
-                    c.warmup_gradient_evaluations + c.sampling_gradient_evaluations
+                    c.warmup.gradient_evaluations + c.sampling.gradient_evaluations
                 } else {
-                    c.warmup_density_evaluations + c.sampling_density_evaluations
+                    c.warmup.density_evaluations + c.sampling.density_evaluations
                 };
                 n as f64
             })

@@ -47,15 +47,14 @@ fn main() {
     let warmup: usize = arg(&args, "--warmup", 500);
     let draws: usize = arg(&args, "--draws", 500);
     let out = PathBuf::from(arg(&args, "--out", "papers/john2018/k-seeds".to_string()));
-    let metric_adaptation = match arg(&args, "--metric-adaptation", "laplace".to_string()).as_str()
-    {
-        "laplace" => MetricAdaptation::Laplace,
-        "windows" => MetricAdaptation::Windows,
-        other => {
-            eprintln!("--metric-adaptation {other}: expected laplace or windows");
-            std::process::exit(2);
-        }
-    };
+    let metric_adaptation: MetricAdaptation =
+        match arg(&args, "--metric-adaptation", "laplace".to_string()).parse() {
+            Ok(m) => m,
+            Err(e) => {
+                eprintln!("--metric-adaptation: {e}");
+                std::process::exit(2);
+            }
+        };
     let run = RunSettings {
         sampler: SamplerKind::NutsDense,
         chains: 4,

@@ -46,6 +46,27 @@ impl Error {
     }
 }
 
+/// The one of `all` whose name is `text`, for the library's enums' `FromStr`; otherwise a
+/// settings error on `setting` that lists the names.
+pub(crate) fn parse_name<T: Copy>(
+    setting: &str,
+    text: &str,
+    all: &[T],
+    name: impl Fn(&T) -> &'static str,
+) -> Result<T, Error> {
+    all.iter()
+        .copied()
+        .find(|t| name(t) == text)
+        .ok_or_else(|| {
+            let names: Vec<&str> = all.iter().map(name).collect();
+            Error::setting(
+                setting,
+                text,
+                format!("expected one of {}", names.join(", ")),
+            )
+        })
+}
+
 impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {

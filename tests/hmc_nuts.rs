@@ -125,7 +125,7 @@ where
     let min_ess = (0..d)
         .map(|j| ess_bulk(&columns(j)))
         .fold(f64::INFINITY, f64::min);
-    let gradients: u64 = chains.iter().map(|c| c.sampling_gradient_evaluations).sum();
+    let gradients: u64 = chains.iter().map(|c| c.sampling.gradient_evaluations).sum();
     let divergences: usize = chains.iter().map(|c| c.divergences).sum();
     let accept = chains.iter().map(|c| c.mean_accept_stat).sum::<f64>() / chains.len() as f64;
     let leapfrogs = gradients as f64 / (chains.len() * settings.draws) as f64;

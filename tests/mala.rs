@@ -524,13 +524,13 @@ fn the_driver_reports_fisher_malas_metrics_and_cpu_time_per_phase() {
     )
     .unwrap();
     // One metric per gradient; the warm-up's include the initial point's.
-    assert_eq!(out.warmup_metric_evaluations, 201);
-    assert_eq!(out.warmup_gradient_evaluations, 201);
-    assert_eq!(out.sampling_metric_evaluations, 300);
-    assert_eq!(out.sampling_gradient_evaluations, 300);
+    assert_eq!(out.warmup.metric_evaluations, 201);
+    assert_eq!(out.warmup.gradient_evaluations, 201);
+    assert_eq!(out.sampling.metric_evaluations, 300);
+    assert_eq!(out.sampling.gradient_evaluations, 300);
     for (cpu, wall) in [
-        (out.warmup_cpu_seconds, out.warmup_wall_seconds),
-        (out.sampling_cpu_seconds, out.sampling_wall_seconds),
+        (out.warmup.cpu_seconds, out.warmup.wall_seconds),
+        (out.sampling.cpu_seconds, out.sampling.wall_seconds),
     ] {
         assert!(
             cpu >= 0.0 && cpu <= wall + 0.01,
@@ -573,7 +573,7 @@ fn fisher_mala_with_the_gauss_newton_metric_mixes_well_on_the_bm2_k3_posterior()
     let seconds = started.elapsed().as_secs_f64();
     let failures: u64 = runs.iter().map(|(_, k)| k.failures()).sum();
     let chains = outputs(runs);
-    let gradients: u64 = chains.iter().map(|c| c.sampling_gradient_evaluations).sum();
+    let gradients: u64 = chains.iter().map(|c| c.sampling.gradient_evaluations).sum();
     let r = max_rhat(&chains);
     let ess = min_ess_bulk(&chains);
     let accept = mean_accept(&chains);

@@ -380,12 +380,12 @@ fn write_records(options: &BenchOptions, records: &[BenchRecord]) -> Result<(), 
             r.lower_bound,
             r.divergences,
             c.wall_s,
-            c.map_wall_s,
-            c.map_cpu_s,
-            c.warmup_wall_s,
-            c.warmup_cpu_s,
-            c.sampling_wall_s,
-            c.sampling_cpu_s,
+            c.map.wall_seconds,
+            c.map.cpu_seconds,
+            c.warmup.wall_seconds,
+            c.warmup.cpu_seconds,
+            c.sampling.wall_seconds,
+            c.sampling.cpu_seconds,
             c.total_cpu_s,
             c.eval_kind,
             c.evaluations,
@@ -532,7 +532,7 @@ mod tests {
             "divergences": 0}"#;
         let old: BenchRecord = serde_json::from_str(old).unwrap();
         assert_eq!(old.cost.min_ess_per_s, 275.0);
-        assert_eq!(old.cost.warmup_wall_s, 0.057);
+        assert_eq!(old.cost.warmup.wall_seconds, 0.057);
         assert_eq!(old.cost.evaluations, 100000);
         assert_eq!(old.prior, "");
     }

@@ -1,6 +1,8 @@
 //! The commands behind the binary: each turns options into library calls and reports. Kept in
 //! the library so that tests drive them exactly as a user does.
 
+// The command line's reading of the library's enums (clap's `ValueEnum`).
+mod args;
 pub mod bench;
 pub mod cases;
 pub mod diagnose;

@@ -170,9 +170,9 @@ pub fn write_outputs(
 fn cost_columns(c: &RunCost) -> String {
     format!(
         "{},{},{},{},{},{},{},{},{},{}",
-        c.map_cpu_s,
-        c.warmup_cpu_s,
-        c.sampling_cpu_s,
+        c.map.cpu_seconds,
+        c.warmup.cpu_seconds,
+        c.sampling.cpu_seconds,
         c.total_cpu_s,
         c.evaluations,
         c.all_evaluations,

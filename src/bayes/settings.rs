@@ -13,12 +13,35 @@ pub enum SpreadReading {
     Variance,
 }
 
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+/// The family of the discrepancy coefficients' priors.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum CoefficientFamily {
     #[default]
     Laplace,
     Gaussian,
+}
+
+impl CoefficientFamily {
+    /// The name files and labels use ("laplace", "gaussian").
+    pub fn name(&self) -> &'static str {
+        match self {
+            CoefficientFamily::Laplace => "laplace",
+            CoefficientFamily::Gaussian => "gaussian",
+        }
+    }
+
+    pub const ALL: [CoefficientFamily; 2] =
+        [CoefficientFamily::Laplace, CoefficientFamily::Gaussian];
+}
+
+/// A family by its [`CoefficientFamily::name`].
+impl std::str::FromStr for CoefficientFamily {
+    type Err = crate::error::Error;
+
+    fn from_str(text: &str) -> Result<Self, crate::error::Error> {
+        crate::error::parse_name("family", text, &Self::ALL, Self::name)
+    }
 }
 
 /// Priors of the discrepancy coefficients: V[a_j] = V₀/(j+1)^p with V₀ the variance of the
@@ -47,11 +70,7 @@ impl Default for CoefficientPrior {
 impl CoefficientPrior {
     /// "laplace, p = 0" (the paper's), "gaussian, p = 2", …
     pub fn label(&self) -> String {
-        let family = match self.family {
-            CoefficientFamily::Laplace => "laplace",
-            CoefficientFamily::Gaussian => "gaussian",
-        };
-        format!("{family}, p = {}", self.decay_power)
+        format!("{}, p = {}", self.family.name(), self.decay_power)
     }
 
     /// The prior of coefficient a_j.

@@ -14,7 +14,7 @@ use crate::error::Error;
 use crate::optimize::{MapSettings, find_map};
 use crate::pipeline::{RunOutput, RunSettings, finish_run, run_sampler};
 use crate::sampler::driver::chain_rng;
-use crate::sampler::{ChainOutput, DrawRecord};
+use crate::sampler::{ChainOutput, DrawRecord, PhaseCost};
 use crate::study::{Predictive, Problem, posterior_predictive};
 
 use super::settings::{LAPLACE_DRAWS, uses_laplace};
@@ -149,16 +149,11 @@ fn laplace_run(posterior: &mut CalibrationPosterior, seed: u64) -> Result<RunOut
         draws,
         unconstrained,
         records: vec![DrawRecord::default(); LAPLACE_DRAWS],
-        warmup_wall_seconds: 0.0,
-        warmup_cpu_seconds: 0.0,
-        sampling_wall_seconds: started.elapsed().as_secs_f64(),
-        sampling_cpu_seconds: 0.0,
-        warmup_density_evaluations: 0,
-        warmup_gradient_evaluations: 0,
-        warmup_metric_evaluations: 0,
-        sampling_density_evaluations: 0,
-        sampling_gradient_evaluations: 0,
-        sampling_metric_evaluations: 0,
+        warmup: PhaseCost::default(),
+        sampling: PhaseCost {
+            wall_seconds: started.elapsed().as_secs_f64(),
+            ..PhaseCost::default()
+        },
         uses_gradient: true,
         divergences: 0,
         mean_accept_stat: 1.0,

@@ -15,6 +15,7 @@ mod model_file;
 mod model_tables;
 mod recording;
 mod table;
+mod toml_lines;
 
 pub use atomic::{AtomicFile, write_atomically};
 pub use draws::{CmdStanWriter, DrawSet, SAMPLER_COLUMNS, SamplerColumns, read_draws};

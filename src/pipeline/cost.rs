@@ -5,26 +5,24 @@
 use serde::{Deserialize, Serialize};
 
 use super::RunOutput;
+use crate::sampler::clock::Elapsed;
 
-/// The cost of one run and min bulk-ESS per unit of it. Seconds are wall time (`*_wall_s`,
-/// `wall_s`) or CPU time of the threads that did the work (`*_cpu_s`); the chains' phases are
-/// summed over chains. Reading older files, `map_s` is `map_wall_s` and `warmup_s` is
-/// `warmup_wall_s` (then the maximum over chains, not yet the sum).
+/// The cost of one run and min bulk-ESS per unit of it. Seconds are wall time or CPU time of
+/// the threads that did the work; the chains' phases are summed over chains.
+///
+/// Written flat (`wall_s`, `map_wall_s`, `map_cpu_s`, …, `min_ess_per_s`): bench.json and
+/// sweep.json are read by scripts and by later runs, so they go through a flat mirror,
+/// `CostRecord`, that keeps their keys.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[serde(from = "CostRecord", into = "CostRecord")]
 pub struct RunCost {
     /// Wall time of the whole run a user waits for: MAP, initial points, warm-up, sampling.
     pub wall_s: f64,
     /// The MAP search and the initial points.
-    #[serde(alias = "map_s")]
-    pub map_wall_s: f64,
-    pub map_cpu_s: f64,
-    #[serde(alias = "warmup_s")]
-    pub warmup_wall_s: f64,
-    pub warmup_cpu_s: f64,
-    pub sampling_wall_s: f64,
-    pub sampling_cpu_s: f64,
-    /// `map_cpu_s + warmup_cpu_s + sampling_cpu_s`.
+    pub map: Elapsed,
+    pub warmup: Elapsed,
+    pub sampling: Elapsed,
+    /// The three phases' CPU seconds together.
     pub total_cpu_s: f64,
     /// `gradient` for gradient samplers, `density` for the random walks.
     pub eval_kind: String,
@@ -48,48 +46,119 @@ pub struct RunCost {
 
 impl RunCost {
     pub fn of(run: &RunOutput, uses_gradient: bool) -> Self {
-        let metrics = run.map_metric_evaluations
-            + run.warmup_metric_evaluations
-            + run.sampling_metric_evaluations;
+        let (map, warmup, sampling) = (&run.map, &run.warmup, &run.sampling);
+        let metrics =
+            map.metric_evaluations + warmup.metric_evaluations + sampling.metric_evaluations;
         let (evaluations, all_evaluations, eval_kind) = if uses_gradient {
             (
-                run.sampling_gradient_evaluations,
-                run.map_gradient_evaluations
-                    + run.warmup_gradient_evaluations
-                    + run.sampling_gradient_evaluations
+                sampling.gradient_evaluations,
+                map.gradient_evaluations
+                    + warmup.gradient_evaluations
+                    + sampling.gradient_evaluations
                     + metrics,
                 "gradient",
             )
         } else {
             (
-                run.sampling_density_evaluations,
-                run.map_density_evaluations
-                    + run.map_gradient_evaluations
-                    + run.warmup_density_evaluations
-                    + run.sampling_density_evaluations
+                sampling.density_evaluations,
+                map.density_evaluations
+                    + map.gradient_evaluations
+                    + warmup.density_evaluations
+                    + sampling.density_evaluations
                     + metrics,
                 "density",
             )
         };
-        let total_cpu_s = run.map_cpu_seconds + run.warmup_cpu_seconds + run.sampling_cpu_seconds;
+        let total_cpu_s = map.cpu_seconds + warmup.cpu_seconds + sampling.cpu_seconds;
         let ess = run.min_ess_bulk;
         Self {
             wall_s: run.wall_seconds,
-            map_wall_s: run.map_wall_seconds,
-            map_cpu_s: run.map_cpu_seconds,
-            warmup_wall_s: run.warmup_wall_seconds,
-            warmup_cpu_s: run.warmup_cpu_seconds,
-            sampling_wall_s: run.sampling_wall_seconds,
-            sampling_cpu_s: run.sampling_cpu_seconds,
+            map: map.time(),
+            warmup: warmup.time(),
+            sampling: sampling.time(),
             total_cpu_s,
             eval_kind: eval_kind.into(),
             evaluations,
             all_evaluations,
-            min_ess_per_s: ess / run.sampling_cpu_seconds,
+            min_ess_per_s: ess / sampling.cpu_seconds,
             min_ess_per_total_s: ess / total_cpu_s,
             min_ess_per_wall_s: ess / run.wall_seconds,
             min_ess_per_eval: ess / evaluations.max(1) as f64,
             min_ess_per_all_evals: ess / all_evaluations.max(1) as f64,
+        }
+    }
+}
+
+/// [`RunCost`] as the files hold it: one key per phase and clock (`*_wall_s`, `*_cpu_s`), in
+/// the order they have always been written. Reading older files, `map_s` is `map_wall_s` and
+/// `warmup_s` is `warmup_wall_s` (then the maximum over chains, not yet the sum); keys a file
+/// lacks read as zero.
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[serde(default)]
+struct CostRecord {
+    wall_s: f64,
+    #[serde(alias = "map_s")]
+    map_wall_s: f64,
+    map_cpu_s: f64,
+    #[serde(alias = "warmup_s")]
+    warmup_wall_s: f64,
+    warmup_cpu_s: f64,
+    sampling_wall_s: f64,
+    sampling_cpu_s: f64,
+    total_cpu_s: f64,
+    eval_kind: String,
+    evaluations: u64,
+    all_evaluations: u64,
+    min_ess_per_s: f64,
+    min_ess_per_total_s: f64,
+    min_ess_per_wall_s: f64,
+    min_ess_per_eval: f64,
+    min_ess_per_all_evals: f64,
+}
+
+impl From<RunCost> for CostRecord {
+    fn from(c: RunCost) -> Self {
+        Self {
+            wall_s: c.wall_s,
+            map_wall_s: c.map.wall_seconds,
+            map_cpu_s: c.map.cpu_seconds,
+            warmup_wall_s: c.warmup.wall_seconds,
+            warmup_cpu_s: c.warmup.cpu_seconds,
+            sampling_wall_s: c.sampling.wall_seconds,
+            sampling_cpu_s: c.sampling.cpu_seconds,
+            total_cpu_s: c.total_cpu_s,
+            eval_kind: c.eval_kind,
+            evaluations: c.evaluations,
+            all_evaluations: c.all_evaluations,
+            min_ess_per_s: c.min_ess_per_s,
+            min_ess_per_total_s: c.min_ess_per_total_s,
+            min_ess_per_wall_s: c.min_ess_per_wall_s,
+            min_ess_per_eval: c.min_ess_per_eval,
+            min_ess_per_all_evals: c.min_ess_per_all_evals,
+        }
+    }
+}
+
+impl From<CostRecord> for RunCost {
+    fn from(r: CostRecord) -> Self {
+        let phase = |wall_seconds, cpu_seconds| Elapsed {
+            wall_seconds,
+            cpu_seconds,
+        };
+        Self {
+            wall_s: r.wall_s,
+            map: phase(r.map_wall_s, r.map_cpu_s),
+            warmup: phase(r.warmup_wall_s, r.warmup_cpu_s),
+            sampling: phase(r.sampling_wall_s, r.sampling_cpu_s),
+            total_cpu_s: r.total_cpu_s,
+            eval_kind: r.eval_kind,
+            evaluations: r.evaluations,
+            all_evaluations: r.all_evaluations,
+            min_ess_per_s: r.min_ess_per_s,
+            min_ess_per_total_s: r.min_ess_per_total_s,
+            min_ess_per_wall_s: r.min_ess_per_wall_s,
+            min_ess_per_eval: r.min_ess_per_eval,
+            min_ess_per_all_evals: r.min_ess_per_all_evals,
         }
     }
 }
@@ -113,6 +182,7 @@ pub fn ratio_2sf(x: f64) -> String {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
+    use crate::sampler::PhaseCost;
 
     /// Four chains: MAP 0.5 s CPU (60 gradients, 10 metrics, 40 densities); each chain
     /// 0.25 s of warm-up (700 gradients, 300 metrics) and 2 s of sampling (2000 gradients,
@@ -125,21 +195,27 @@ pub(crate) mod tests {
             max_rhat: 1.0,
             min_ess_bulk: min_ess,
             wall_seconds: 6.0,
-            map_wall_seconds: 0.6,
-            map_cpu_seconds: 0.5,
-            warmup_wall_seconds: 1.2,
-            warmup_cpu_seconds: 1.0,
-            sampling_wall_seconds: 9.0,
-            sampling_cpu_seconds: 8.0,
-            map_density_evaluations: 40,
-            map_gradient_evaluations: 60,
-            map_metric_evaluations: 10,
-            warmup_density_evaluations: 4 * 500,
-            warmup_gradient_evaluations: 4 * 700,
-            warmup_metric_evaluations: 4 * 300,
-            sampling_density_evaluations: 4 * 3000,
-            sampling_gradient_evaluations: 4 * 2000,
-            sampling_metric_evaluations: 4 * 1000,
+            map: PhaseCost {
+                wall_seconds: 0.6,
+                cpu_seconds: 0.5,
+                density_evaluations: 40,
+                gradient_evaluations: 60,
+                metric_evaluations: 10,
+            },
+            warmup: PhaseCost {
+                wall_seconds: 1.2,
+                cpu_seconds: 1.0,
+                density_evaluations: 4 * 500,
+                gradient_evaluations: 4 * 700,
+                metric_evaluations: 4 * 300,
+            },
+            sampling: PhaseCost {
+                wall_seconds: 9.0,
+                cpu_seconds: 8.0,
+                density_evaluations: 4 * 3000,
+                gradient_evaluations: 4 * 2000,
+                metric_evaluations: 4 * 1000,
+            },
             divergences: 0,
             map_log_density: 0.0,
             log_evidence_laplace: 0.0,
@@ -159,8 +235,8 @@ pub(crate) mod tests {
         // Fisher metrics of every phase count as gradients: 60 + 2800 + 8000 + (10 + 1200 + 4000).
         assert_eq!(cost.all_evaluations, 16070);
         assert_eq!(cost.min_ess_per_all_evals, 850.0 / 16070.0);
-        assert_eq!(cost.warmup_wall_s, 1.2);
-        assert_eq!(cost.sampling_wall_s, 9.0);
+        assert_eq!(cost.warmup.wall_seconds, 1.2);
+        assert_eq!(cost.sampling.wall_seconds, 9.0);
     }
 
     #[test]
@@ -175,11 +251,46 @@ pub(crate) mod tests {
     }
 
     #[test]
+    fn the_cost_is_written_flat_with_the_keys_it_always_had() {
+        let cost = RunCost::of(&run(850.0), true);
+        let text = serde_json::to_string(&cost).unwrap();
+        let keys: Vec<&str> = text
+            .trim_matches(['{', '}'])
+            .split(',')
+            .map(|pair| pair.split(':').next().unwrap().trim_matches('"'))
+            .collect();
+        assert_eq!(
+            keys,
+            [
+                "wall_s",
+                "map_wall_s",
+                "map_cpu_s",
+                "warmup_wall_s",
+                "warmup_cpu_s",
+                "sampling_wall_s",
+                "sampling_cpu_s",
+                "total_cpu_s",
+                "eval_kind",
+                "evaluations",
+                "all_evaluations",
+                "min_ess_per_s",
+                "min_ess_per_total_s",
+                "min_ess_per_wall_s",
+                "min_ess_per_eval",
+                "min_ess_per_all_evals",
+            ]
+        );
+        assert!(text.contains(r#""map_cpu_s":0.5,"#), "{text}");
+        let back: RunCost = serde_json::from_str(&text).unwrap();
+        assert_eq!(back, cost);
+    }
+
+    #[test]
     fn older_files_read_with_their_field_names() {
         let cost: RunCost =
             serde_json::from_str(r#"{"wall_s": 3.0, "map_s": 0.25, "warmup_s": 1.5}"#).unwrap();
         assert_eq!(
-            (cost.wall_s, cost.map_wall_s, cost.warmup_wall_s),
+            (cost.wall_s, cost.map.wall_seconds, cost.warmup.wall_seconds),
             (3.0, 0.25, 1.5)
         );
         assert_eq!(cost.total_cpu_s, 0.0);

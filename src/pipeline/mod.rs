@@ -9,7 +9,7 @@ use std::time::Instant;
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use nalgebra::DVector;
 use rand_distr::{Distribution, StandardNormal};
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 
 use crate::density::{Counted, DensityError, FisherMetric, LogDensity, StartingPoint};
 use crate::diagnostics::{ParameterSummary, summarize};
@@ -29,194 +29,23 @@ use crate::sampler::mala::{Mala, MalaAdaptation};
 use crate::sampler::metric::{Metric, MetricKind};
 use crate::sampler::metropolis::{Metropolis, PyMc3Tuning};
 use crate::sampler::nuts::{Nuts, NutsSettings};
-use crate::sampler::{Adaptation, ChainOutput, ChainSettings, Kernel, run_chains};
+use crate::sampler::{Adaptation, ChainOutput, Kernel, run_chains};
 
 use crate::error::{Error, InputError};
 
 pub mod cost;
+pub mod settings;
+pub use crate::sampler::PhaseCost;
 pub use cost::{RunCost, ratio_2sf};
+pub use settings::{
+    LAPLACE_TARGET_ACCEPT, LAPLACE_WARMUP, MetricAdaptation, RunSettings, SamplerKind,
+    default_warmup,
+};
 
 /// What the pipeline can fit: a log density with a gradient and a Gauss–Newton metric that
 /// knows a sensible point to start a search from, and that chains can clone.
 pub trait Fittable: FisherMetric + StartingPoint + Clone + Send + Sync {}
 impl<P: FisherMetric + StartingPoint + Clone + Send + Sync> Fittable for P {}
-
-/// The samplers a user can pick.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, clap::ValueEnum)]
-#[serde(rename_all = "kebab-case")]
-pub enum SamplerKind {
-    /// The paper's Metropolis: one random-walk step per variable in turn, tuned as PyMC3 did.
-    Metropolis,
-    /// Adaptive Metropolis (Haario et al. 2001): joint proposal from the warm-up covariance.
-    AdaptiveMetropolis,
-    /// Preconditioned MALA; the preconditioner starts at the inverse MAP Hessian.
-    Mala,
-    /// Static HMC, diagonal metric: the Laplace variances (or Stan's windows).
-    HmcDiag,
-    /// Static HMC, dense metric: the inverse MAP Hessian (or Stan's windows from it).
-    HmcDense,
-    /// NUTS, diagonal metric: the Laplace variances (or Stan's windows).
-    NutsDiag,
-    /// NUTS, dense metric: the inverse MAP Hessian (or Stan's windows from it).
-    NutsDense,
-    /// Simplified manifold MALA with the Gauss–Newton (Fisher) metric.
-    FisherMala,
-}
-
-impl SamplerKind {
-    pub fn name(&self) -> &'static str {
-        match self {
-            SamplerKind::Metropolis => "metropolis",
-            SamplerKind::AdaptiveMetropolis => "adaptive-metropolis",
-            SamplerKind::Mala => "mala",
-            SamplerKind::HmcDiag => "hmc-diag",
-            SamplerKind::HmcDense => "hmc-dense",
-            SamplerKind::NutsDiag => "nuts-diag",
-            SamplerKind::NutsDense => "nuts-dense",
-            SamplerKind::FisherMala => "fisher-mala",
-        }
-    }
-
-    pub fn uses_gradient(&self) -> bool {
-        !matches!(
-            self,
-            SamplerKind::Metropolis | SamplerKind::AdaptiveMetropolis
-        )
-    }
-
-    /// HMC and NUTS, whose metric [`MetricAdaptation`] tunes.
-    pub fn is_hamiltonian(&self) -> bool {
-        matches!(
-            self,
-            SamplerKind::HmcDiag
-                | SamplerKind::HmcDense
-                | SamplerKind::NutsDiag
-                | SamplerKind::NutsDense
-        )
-    }
-
-    pub const ALL: [SamplerKind; 8] = [
-        SamplerKind::Metropolis,
-        SamplerKind::AdaptiveMetropolis,
-        SamplerKind::Mala,
-        SamplerKind::HmcDiag,
-        SamplerKind::HmcDense,
-        SamplerKind::NutsDiag,
-        SamplerKind::NutsDense,
-        SamplerKind::FisherMala,
-    ];
-}
-
-/// How HMC and NUTS tune their metric in warm-up. Both start from the Laplace covariance (the
-/// inverse MAP Hessian, or its diagonal).
-#[derive(
-    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize, clap::ValueEnum,
-)]
-#[serde(rename_all = "kebab-case")]
-pub enum MetricAdaptation {
-    /// Keep the Laplace covariance; warm-up tunes the step size alone. The calibration
-    /// posteriors are close to Gaussian in the unconstrained coordinates, so the Hessian is a
-    /// better metric than any estimate from a few hundred correlated draws (papers/john2018,
-    /// "The warm-up"), and warm-up shrinks to what dual averaging needs.
-    #[default]
-    Laplace,
-    /// Stan's windows: re-estimate the metric from the chain's own warm-up draws, shrunk toward
-    /// the one in use. For posteriors far from Gaussian; it needs a long warm-up (≥ 1000).
-    Windows,
-}
-
-/// Warm-up per chain when none is given. HMC and NUTS on the Laplace metric only tune a step
-/// size: on the paper's data every length from 10 to 300 kept R-hat ≤ 1.01 and bulk ESS
-/// ≥ 2000 at every K = 0…20, but at 10 the unsettled step size left 31 divergent transitions
-/// in the 21 runs, from 20 on 1–3 (papers/john2018, "The warm-up"). 100 leaves dual averaging
-/// (t₀ = 10) ten times its damping span to settle, for posteriors less Gaussian than the
-/// paper's, at a tenth of 1000 draws. Everything else keeps Stan's 1000: the windows need it
-/// to estimate a metric, and MALA's step-size search is noisier.
-pub fn default_warmup(sampler: SamplerKind, metric: MetricAdaptation) -> usize {
-    if sampler.is_hamiltonian() && metric == MetricAdaptation::Laplace {
-        LAPLACE_WARMUP
-    } else {
-        1000
-    }
-}
-
-/// See [`default_warmup`].
-pub const LAPLACE_WARMUP: usize = 100;
-
-/// The mean acceptance statistic dual averaging aims at on the Laplace metric, above Stan's
-/// 0.8. The whitened target is nearly isotropic, so the step size lands near the leapfrog's
-/// stability limit; where the posterior's curvature grows away from the MAP (R traded against
-/// δ at large K) 0.8 left 3–22 divergent transitions in 4000 at K = 19 on four chain seeds,
-/// where Stan's windows, which settle on smaller steps, left 0–3. Raising the target is
-/// Stan's own remedy for divergences: 0.85 left at most one per K from 17 to 20, at 13–47%
-/// more gradients at K = 19 (papers/john2018, "The warm-up").
-pub const LAPLACE_TARGET_ACCEPT: f64 = 0.85;
-
-impl MetricAdaptation {
-    pub fn name(&self) -> &'static str {
-        match self {
-            MetricAdaptation::Laplace => "laplace",
-            MetricAdaptation::Windows => "windows",
-        }
-    }
-}
-
-/// How to run a sampler.
-#[derive(Clone, Debug, Serialize)]
-pub struct RunSettings {
-    pub sampler: SamplerKind,
-    pub chains: usize,
-    pub chain: ChainSettings,
-    pub seed: u64,
-    /// Worker threads (all cores when `None`); the draws do not depend on it.
-    pub threads: Option<usize>,
-    /// Initial points are the MAP plus draws from the Laplace approximation with its standard
-    /// deviations inflated by this factor, so that R-hat can detect chains that do not mix.
-    pub init_dispersion: f64,
-    pub quiet: bool,
-    /// HMC/NUTS: write the adapted step size and metric (of chain 1) here.
-    pub save_adaptation: Option<PathBuf>,
-    /// HMC/NUTS: start every chain from this adaptation and skip adapting.
-    pub load_adaptation: Option<PathBuf>,
-    /// HMC/NUTS: how warm-up tunes the metric.
-    pub metric_adaptation: MetricAdaptation,
-}
-
-impl Default for RunSettings {
-    fn default() -> Self {
-        Self {
-            sampler: SamplerKind::AdaptiveMetropolis,
-            chains: 4,
-            chain: ChainSettings::default(),
-            seed: crate::synthetic::DEFAULT_SEED,
-            threads: None,
-            init_dispersion: 3.0,
-            quiet: false,
-            save_adaptation: None,
-            load_adaptation: None,
-            metric_adaptation: MetricAdaptation::default(),
-        }
-    }
-}
-
-impl RunSettings {
-    pub fn validate(&self) -> Result<(), Error> {
-        if self.chains == 0 {
-            return Err(Error::setting("chains", 0, "need at least one chain"));
-        }
-        if self.threads == Some(0) {
-            return Err(Error::setting("threads", 0, "need at least one thread"));
-        }
-        self.chain.validate().map_err(|e| {
-            Error::Settings(crate::error::SettingError {
-                name: "keep/draws".into(),
-                value: None,
-                message: e.to_string(),
-            })
-        })?;
-        Ok(())
-    }
-}
 
 /// The result of a run.
 #[derive(Clone, Debug, Serialize)]
@@ -230,26 +59,13 @@ pub struct RunOutput {
     /// Wall time of the whole run: MAP, initial points, chains, diagnostics.
     pub wall_seconds: f64,
     /// The MAP search and the initial points drawn around it, on the calling thread.
-    pub map_wall_seconds: f64,
-    pub map_cpu_seconds: f64,
+    pub map: PhaseCost,
     /// Warm-up and sampling, each summed over chains, wall time and CPU time alike: the
     /// phases then add up to the chains' whole cost whatever the thread count (a maximum over
     /// chains would not, and with fewer threads than chains a chain's wall time includes
     /// waiting for a core, which its CPU time does not).
-    pub warmup_wall_seconds: f64,
-    pub warmup_cpu_seconds: f64,
-    pub sampling_wall_seconds: f64,
-    pub sampling_cpu_seconds: f64,
-    /// Evaluations of each phase, summed over chains; a Fisher metric is a "metric".
-    pub map_density_evaluations: u64,
-    pub map_gradient_evaluations: u64,
-    pub map_metric_evaluations: u64,
-    pub warmup_density_evaluations: u64,
-    pub warmup_gradient_evaluations: u64,
-    pub warmup_metric_evaluations: u64,
-    pub sampling_density_evaluations: u64,
-    pub sampling_gradient_evaluations: u64,
-    pub sampling_metric_evaluations: u64,
+    pub warmup: PhaseCost,
+    pub sampling: PhaseCost,
     pub divergences: usize,
     pub map_log_density: f64,
     pub log_evidence_laplace: f64,
@@ -396,21 +212,10 @@ pub fn finish_run(
         max_rhat,
         min_ess_bulk,
         wall_seconds: started.elapsed().as_secs_f64(),
-        map_wall_seconds: 0.0,
-        map_cpu_seconds: 0.0,
-        warmup_wall_seconds: chains.iter().map(|c| c.warmup_wall_seconds).sum(),
-        warmup_cpu_seconds: chains.iter().map(|c| c.warmup_cpu_seconds).sum(),
-        sampling_wall_seconds: chains.iter().map(|c| c.sampling_wall_seconds).sum(),
-        sampling_cpu_seconds: chains.iter().map(|c| c.sampling_cpu_seconds).sum(),
-        map_density_evaluations: 0,
-        map_gradient_evaluations: 0,
-        map_metric_evaluations: 0,
-        warmup_density_evaluations: chains.iter().map(|c| c.warmup_density_evaluations).sum(),
-        warmup_gradient_evaluations: chains.iter().map(|c| c.warmup_gradient_evaluations).sum(),
-        warmup_metric_evaluations: chains.iter().map(|c| c.warmup_metric_evaluations).sum(),
-        sampling_density_evaluations: chains.iter().map(|c| c.sampling_density_evaluations).sum(),
-        sampling_gradient_evaluations: chains.iter().map(|c| c.sampling_gradient_evaluations).sum(),
-        sampling_metric_evaluations: chains.iter().map(|c| c.sampling_metric_evaluations).sum(),
+        // The MAP is not a chain's: the caller that ran one fills it in.
+        map: PhaseCost::default(),
+        warmup: chains.iter().map(|c| c.warmup).sum(),
+        sampling: chains.iter().map(|c| c.sampling).sum(),
         divergences: chains.iter().map(|c| c.divergences).sum(),
         map_log_density: map.log_density,
         log_evidence_laplace: map.log_evidence_laplace,
@@ -439,15 +244,11 @@ pub fn run_sampler<P: Fittable>(
         settings.init_dispersion,
         settings.seed,
     )?;
-    let map_time = map_watch.elapsed();
+    let map_cost = PhaseCost::counted(map_watch.elapsed(), &counted);
     let label = format!("{label} {}", settings.sampler.name());
     let chains = dispatch(posterior, &map, &inits, settings, &label)?;
     Ok(RunOutput {
-        map_wall_seconds: map_time.wall_seconds,
-        map_cpu_seconds: map_time.cpu_seconds,
-        map_density_evaluations: counted.density_evaluations,
-        map_gradient_evaluations: counted.gradient_evaluations,
-        map_metric_evaluations: counted.metric_evaluations,
+        map: map_cost,
         ..finish_run(settings.sampler.name(), chains, &map, started)
     })
 }

@@ -10,7 +10,7 @@
 use nalgebra::DMatrix;
 use rand_distr::{Distribution, StandardNormal};
 
-use super::adapt::{Welford, WelfordForm};
+use super::welford::{Welford, WelfordForm};
 use super::{
     Adaptation, ChainRng, Info, Kernel, State, Transition, proposal_log_density,
     random_walk_decision,

@@ -10,7 +10,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::clock::Stopwatch;
-use super::{Adaptation, Info, Kernel, State};
+use super::{Adaptation, Info, Kernel, PhaseCost, State};
 use crate::density::{Counted, DensityError, LogDensity};
 
 /// How long a chain runs and what it keeps.
@@ -78,19 +78,10 @@ pub struct ChainOutput {
     /// Kept draws in the sampler's unconstrained coordinates.
     pub unconstrained: Vec<Vec<f64>>,
     pub records: Vec<DrawRecord>,
-    /// Wall time and CPU time (of the thread that ran the chain) of each phase, in seconds.
-    pub warmup_wall_seconds: f64,
-    pub warmup_cpu_seconds: f64,
-    pub sampling_wall_seconds: f64,
-    pub sampling_cpu_seconds: f64,
-    pub warmup_density_evaluations: u64,
-    pub warmup_gradient_evaluations: u64,
-    /// Fisher metrics evaluated (Fisher-MALA evaluates one per proposal).
-    pub warmup_metric_evaluations: u64,
-    /// Evaluations during the sampling phase (all draws, kept or not).
-    pub sampling_density_evaluations: u64,
-    pub sampling_gradient_evaluations: u64,
-    pub sampling_metric_evaluations: u64,
+    /// Warm-up (with the initial point's evaluation) and sampling (all draws, kept or not):
+    /// wall time, CPU time of the thread that ran the chain, and evaluations.
+    pub warmup: PhaseCost,
+    pub sampling: PhaseCost,
     pub uses_gradient: bool,
     pub divergences: usize,
     /// Mean accept_stat over the sampling phase.
@@ -146,12 +137,7 @@ where
         reporter.tick(iteration, &info, divergences_warmup, "warm-up");
     }
     adaptation.finish(&mut kernel);
-    let warmup = warmup_watch.elapsed();
-    let (warmup_density_evaluations, warmup_gradient_evaluations, warmup_metric_evaluations) = (
-        density.density_evaluations,
-        density.gradient_evaluations,
-        density.metric_evaluations,
-    );
+    let warmup = PhaseCost::counted(warmup_watch.elapsed(), &density);
 
     let first_kept = settings.draws - settings.kept();
     let mut draws = Vec::with_capacity(settings.kept());
@@ -183,7 +169,7 @@ where
         }
         reporter.tick(settings.warmup + i, &info, divergences, "sampling");
     }
-    let sampling = sampling_watch.elapsed();
+    let sampling = PhaseCost::counted(sampling_watch.elapsed(), &density).after(&warmup);
     reporter.finish(divergences);
     let output = ChainOutput {
         chain,
@@ -192,16 +178,8 @@ where
         draws,
         unconstrained,
         records,
-        warmup_wall_seconds: warmup.wall_seconds,
-        warmup_cpu_seconds: warmup.cpu_seconds,
-        sampling_wall_seconds: sampling.wall_seconds,
-        sampling_cpu_seconds: sampling.cpu_seconds,
-        warmup_density_evaluations,
-        warmup_gradient_evaluations,
-        warmup_metric_evaluations,
-        sampling_density_evaluations: density.density_evaluations - warmup_density_evaluations,
-        sampling_gradient_evaluations: density.gradient_evaluations - warmup_gradient_evaluations,
-        sampling_metric_evaluations: density.metric_evaluations - warmup_metric_evaluations,
+        warmup,
+        sampling,
         uses_gradient: kernel.uses_gradient(),
         divergences,
         mean_accept_stat: accept_sum / settings.draws as f64,

@@ -13,12 +13,13 @@ use rand::RngExt;
 use rand_distr::StandardNormal;
 use serde::{Deserialize, Serialize};
 
+use super::adapt::doubling_windows;
 pub use super::adapt::{DualAveraging, DualAveragingSettings};
-use super::adapt::{Welford, WelfordForm, doubling_windows};
 use super::langevin::{
     Evaluated, check_state, cholesky_in_place, evaluate, lower_mul, lower_tr_mul, metropolis,
 };
 use super::metric::Metric;
+use super::welford::{Welford, WelfordForm};
 use super::{Adaptation, ChainRng, Info, Kernel, State, Transition};
 use crate::density::LogDensity;
 

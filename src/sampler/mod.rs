@@ -8,6 +8,7 @@
 pub mod adapt;
 pub mod adaptive_metropolis;
 pub mod clock;
+pub mod cost;
 pub mod driver;
 pub mod fisher_mala;
 pub mod hamiltonian;
@@ -18,7 +19,9 @@ pub mod metric;
 pub mod metropolis;
 pub mod nuts;
 pub mod targets;
+pub mod welford;
 
+pub use cost::PhaseCost;
 pub use driver::{ChainOutput, ChainSettings, DrawRecord, run_chain, run_chains};
 
 use rand_chacha::ChaCha8Rng;
