@@ -5,9 +5,9 @@
 
 use std::path::{Path, PathBuf};
 
-use motorcal::app::diagnose::{DiagnoseOptions, diagnose};
-use motorcal::discover::Diagnosis;
+use motorcal::discover::{Diagnosis, DiscoverSettings, discover};
 use motorcal::pipeline::RunSettings;
+use motorcal::study::Problem;
 
 fn dev_dir() -> Option<PathBuf> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/concealed-dev");
@@ -25,9 +25,9 @@ fn answer(case: &Path) -> serde_json::Value {
 }
 
 fn run(case: &Path, rank_only: bool) -> Diagnosis {
-    let options = DiagnoseOptions {
-        data: vec![case.join("recording.csv")],
-        model: case.join("motor.toml"),
+    let problem = Problem::from_files(&[case.join("recording.csv")], &case.join("motor.toml"))
+        .expect("the case reads");
+    let settings = DiscoverSettings {
         k: None,
         candidates: None,
         run: RunSettings {
@@ -41,11 +41,9 @@ fn run(case: &Path, rank_only: bool) -> Diagnosis {
             metric_adaptation: motorcal::discover::METRIC_ADAPTATION,
             ..RunSettings::default()
         },
-        out: None,
-        json: None,
         rank_only,
     };
-    diagnose(&options).expect("diagnose runs")
+    discover(&problem, &settings).expect("diagnose runs")
 }
 
 /// Right: the selected term is the truth, or the truth is a tie of it (the recording cannot

@@ -2,14 +2,13 @@
 //! the input acting differently than modelled: `diagnose` keeps it in the ranking, marks it with
 //! the input step, and does not select it. A load step away from the input's steps is still
 //! found. Synthetic type-B recordings (the reversal profile: 24 V, 8 V from 20% of the record,
-//! −24 V from 60%), made by `motorcal simulate`'s machinery.
+//! −24 V from 60%), made by `motorcal simulate`.
 
 use std::path::PathBuf;
 
-use motorcal::app::diagnose::{DiagnoseOptions, diagnose};
-use motorcal::app::simulate::{InputProfile, SimulateOptions, simulate};
-use motorcal::discover::Diagnosis;
+use motorcal::discover::{Diagnosis, DiscoverSettings, discover};
 use motorcal::pipeline::{RunSettings, SamplerKind};
+use motorcal::study::Problem;
 use motorcal::synthetic::sample_times;
 
 /// The development set's nominal motor (§2.1).
@@ -30,32 +29,44 @@ fn diagnose_load_step_at(t_s: f64, noise_sd: [f64; 2], name: &str) -> Diagnosis 
     )
     .unwrap();
     std::fs::write(&nominal, MOTOR).unwrap();
-    let report = simulate(&SimulateOptions {
-        truth: Some(truth),
-        nominal: Some(nominal),
-        out: dir.clone(),
-        seed: 11,
-        input: InputProfile::Reversal,
-        noise_sd,
-        ..SimulateOptions::default()
-    })
-    .unwrap();
-    let d = diagnose(&DiagnoseOptions {
-        data: vec![report.recording],
-        model: report.nominal,
-        k: None,
-        candidates: None,
-        run: RunSettings {
-            sampler: SamplerKind::NutsDense,
-            quiet: true,
-            ..RunSettings::default()
+    // `motorcal simulate` writes recording.csv and the nominal motor.toml into `--out`.
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_motorcal"))
+        .args([
+            "simulate",
+            "--truth",
+            truth.to_str().unwrap(),
+            "--nominal",
+            nominal.to_str().unwrap(),
+            "--out",
+            dir.to_str().unwrap(),
+            "--seed",
+            "11",
+            "--input",
+            "reversal",
+            "--noise-sd",
+            &noise_sd[0].to_string(),
+            &noise_sd[1].to_string(),
+        ])
+        .output()
+        .expect("the binary runs");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let problem =
+        Problem::from_files(&[dir.join("recording.csv")], &dir.join("motor.toml")).unwrap();
+    let d = discover(
+        &problem,
+        &DiscoverSettings {
+            k: None,
+            candidates: None,
+            run: RunSettings {
+                sampler: SamplerKind::NutsDense,
+                quiet: true,
+                ..RunSettings::default()
+            },
+            rank_only: true,
         },
-        out: None,
-        json: None,
-        rank_only: true,
-    })
+    )
     .unwrap();
-    eprintln!("{}", motorcal::app::diagnose::format_diagnosis(&d));
+    eprintln!("{}", serde_json::to_string_pretty(&d).unwrap());
     d
 }
 

@@ -9,12 +9,11 @@ use std::process::Command;
 
 use nalgebra::DMatrix;
 
-use motorcal::app::diagnose::{DiagnoseOptions, diagnose};
-use motorcal::app::predict::{PredictOptions, predict};
-use motorcal::discover::records_reverse;
+use motorcal::discover::{Diagnosis, DiscoverSettings, discover, records_reverse};
+use motorcal::error::Error;
 use motorcal::ode::SolverSettings;
 use motorcal::pipeline::{RunSettings, SamplerKind};
-use motorcal::study::Problem;
+use motorcal::study::{ChannelResidual, Problem, predict_records, residuals};
 
 fn real_dir() -> Option<PathBuf> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/real");
@@ -49,6 +48,16 @@ fn scratch_file(name: &str, text: &str) -> PathBuf {
     path
 }
 
+/// What `motorcal diagnose` is given: the files and the settings of the diagnosis.
+struct DiagnoseOptions {
+    data: Vec<PathBuf>,
+    model: PathBuf,
+    k: Option<usize>,
+    candidates: Option<Vec<String>>,
+    run: RunSettings,
+    rank_only: bool,
+}
+
 fn options(data: Vec<PathBuf>, model: PathBuf, candidates: &[&str]) -> DiagnoseOptions {
     DiagnoseOptions {
         data,
@@ -60,10 +69,29 @@ fn options(data: Vec<PathBuf>, model: PathBuf, candidates: &[&str]) -> DiagnoseO
             quiet: true,
             ..RunSettings::default()
         },
-        out: None,
-        json: None,
         rank_only: true,
     }
+}
+
+/// The diagnosis `motorcal diagnose` makes of these files (by the library: read, discover).
+fn diagnose(o: &DiagnoseOptions) -> Result<Diagnosis, Error> {
+    let problem = Problem::from_files(&o.data, &o.model)?;
+    discover(
+        &problem,
+        &DiscoverSettings {
+            k: o.k,
+            candidates: o.candidates.clone(),
+            run: o.run.clone(),
+            rank_only: o.rank_only,
+        },
+    )
+}
+
+/// The residual table `motorcal predict` prints for these files.
+fn predict(data: &[PathBuf], model: &Path) -> Result<Vec<ChannelResidual>, Error> {
+    let problem = Problem::from_files(data, model)?;
+    let predictions = predict_records(&problem)?;
+    Ok(residuals(&problem, &predictions))
 }
 
 /// The EMPS README's published symmetric model, as a model file.
@@ -108,13 +136,7 @@ fn the_closed_loop_reproduces_the_readmes_forward_check() {
             .replace("[terms.load_torque]\nT_0 = -3.1648\n", ""),
     );
     let force_rms = |model: PathBuf| {
-        let table = predict(&PredictOptions {
-            data: vec![data.clone()],
-            model,
-            csv: None,
-            json: None,
-        })
-        .unwrap();
+        let table = predict(std::slice::from_ref(&data), &model).unwrap();
         table
             .iter()
             .find(|r| r.channel == "force")
@@ -211,13 +233,7 @@ fn the_measured_current_drives_hsm150_as_its_readme_found() {
         .map(|name| dir.join(format!("hsm150/{name}.csv")))
         .collect();
     let speed_rms = |text: &str, name: &str| {
-        let table = predict(&PredictOptions {
-            data: data.clone(),
-            model: scratch_file(name, text),
-            csv: None,
-            json: None,
-        })
-        .unwrap();
+        let table = predict(&data, &scratch_file(name, text)).unwrap();
         table.iter().map(|r| r.residual_rms).fold(0.0, f64::max)
     };
     // The README: the documented viscous model is off by hundreds of rad/s (460 rad/s RMS over
@@ -296,7 +312,7 @@ fn the_whole_emps_record_names_coulomb_friction_and_the_offset() {
     o.candidates = None;
     o.rank_only = false;
     let d = diagnose(&o).unwrap();
-    println!("{}", motorcal::app::diagnose::format_diagnosis(&d));
+    println!("{}", serde_json::to_string_pretty(&d).unwrap());
     for effect in ["coulomb_friction", "load_torque"] {
         assert!(
             d.selected_set.iter().any(|s| s == effect),
@@ -350,7 +366,7 @@ fn one_hsm150_record_of_each_direction_names_coulomb_friction_and_the_documented
     let mut o = options(data, example("hsm150"), &[]);
     o.candidates = None;
     let d = diagnose(&o).unwrap();
-    println!("{}", motorcal::app::diagnose::format_diagnosis(&d));
+    println!("{}", serde_json::to_string_pretty(&d).unwrap());
     assert!(
         d.selected_set.iter().any(|s| s == "coulomb_friction"),
         "{:?}",
@@ -373,7 +389,7 @@ fn each_hsm150_record_alone_names_one_torque_of_the_tied_pair_not_the_commands_s
         );
         o.candidates = None;
         let d = diagnose(&o).unwrap();
-        println!("{name}:\n{}", motorcal::app::diagnose::format_diagnosis(&d));
+        println!("{name}:\n{}", serde_json::to_string_pretty(&d).unwrap());
         let pair = ["coulomb_friction", "load_torque"];
         assert!(
             d.selected_set.iter().any(|s| pair.contains(&s.as_str())),

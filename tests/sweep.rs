@@ -2,9 +2,9 @@
 //! measures, and `select-k`'s σ rule sees that K = 0 has not stabilised (the discrepancy is
 //! not yet captured, so the noise σ is overestimated, §4.2).
 
-use motorcal::app::sweep::{SweepOptions, merge, sweep, write_outputs};
 use motorcal::bayes::CoefficientPrior;
 use motorcal::paper::sweep::select::{TOLERANCE, evidence, sigma_stabilisation, wasserstein_1};
+use motorcal::paper::sweep::{SweepOptions, SweepRecord, merge, sweep};
 use motorcal::pipeline::{RunSettings, SamplerKind};
 use motorcal::sampler::ChainSettings;
 
@@ -33,9 +33,31 @@ fn options(ks: Vec<usize>, out: &str) -> SweepOptions {
 
 #[test]
 fn a_sweep_writes_the_papers_error_measures_and_k0_has_not_stabilised() {
-    let mut opts = options((0..=4).collect(), "small");
-    opts.figures_at = vec![4];
+    // The command as a user runs it (the records, their files and figures), with the
+    // options' chains: `motorcal sweep` draws the figures and writes the files.
+    let opts = options((0..=4).collect(), "small");
+    let json = opts.out.join("sweep.json");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_motorcal"))
+        .args(["sweep", "--k", "0..=4", "--figures-at", "4", "--quiet"])
+        .args(["--data-seed", &opts.data_seeds[0].to_string()])
+        .args(["--sampler", opts.run.sampler.name()])
+        .args(["--chains", &opts.run.chains.to_string()])
+        .args(["--warmup", &opts.run.chain.warmup.to_string()])
+        .args(["--draws", &opts.run.chain.draws.to_string()])
+        .args(["--seed", &opts.run.seed.to_string()])
+        .arg("--out")
+        .arg(&opts.out)
+        .arg("--json")
+        .arg(&json)
+        .output()
+        .expect("the binary runs");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let from_json: Vec<SweepRecord> =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    // The selection rules need the σ draws, which the files do not carry: the library's sweep
+    // on the same options, which must be what the command wrote.
     let records = sweep(&opts).unwrap();
+    assert_eq!(without_wall_times(&from_json), without_wall_times(&records));
     assert_eq!(
         records.iter().map(|r| r.k).collect::<Vec<_>>(),
         vec![0, 1, 2, 3, 4]
@@ -46,8 +68,16 @@ fn a_sweep_writes_the_papers_error_measures_and_k0_has_not_stabilised() {
         assert!(r.delta_omega.n_mse <= r.delta_omega.n_mse_bound * (1.0 + 1e-12));
         assert!(r.max_rhat.is_finite() && r.min_ess_tail > 0.0);
     }
-    let written = write_outputs(&records, &opts).unwrap();
-    assert!(written.iter().all(|p| p.exists()), "{written:?}");
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    let written: Vec<&str> = stdout
+        .lines()
+        .filter_map(|l| l.strip_prefix("wrote "))
+        .collect();
+    assert!(written.len() >= 2, "{stdout}");
+    assert!(
+        written.iter().all(|p| std::path::Path::new(p).exists()),
+        "{written:?}"
+    );
     for figure in ["fig13-delta-k4.png", "fig14-coefficients-k4.png"] {
         assert!(opts.out.join(figure).exists(), "{figure}");
     }
@@ -83,7 +113,7 @@ fn wasserstein_distance_is_symmetric_and_sees_a_spread() {
 
 /// The JSON a run writes, with the times and the speeds per second (the fields a rerun cannot
 /// repeat) zeroed.
-fn without_wall_times(records: &[motorcal::app::sweep::SweepRecord]) -> String {
+fn without_wall_times(records: &[SweepRecord]) -> String {
     fn zero_times(v: &mut serde_json::Value) {
         if let Some(map) = v.as_object_mut() {
             for (key, value) in map.iter_mut() {

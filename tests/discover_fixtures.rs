@@ -1,0 +1,70 @@
+//! `discover` names the physics of two concealed cases the crate ships, so that a clone without
+//! `../shared` still tests it (the development cases in `tests/diagnose_dev.rs` skip there).
+//! Rank-only: the ranking and the selection, no sampled fits; a few seconds a case.
+//!
+//! The cases were made by the crate's own generator (release build of commit 7142a32), each
+//! on its first draw (`"attempts": 1` in its answer.json, no input fallback):
+//!
+//! ```text
+//! target/release/motorcal simulate --effect coulomb_friction --conceal --input reversal \
+//!     --seed 2 --out tests/fixtures/cases/coulomb_friction
+//! target/release/motorcal simulate --effect torque_constant --conceal --input constant \
+//!     --seed 2 --out tests/fixtures/cases/torque_constant
+//! ```
+//!
+//! Coulomb friction needs a reversal to be told from a load torque; on the constant input the
+//! generator falls back to one (seeds 1–4 on `constant` all did), so the case asks for it.
+
+use std::path::{Path, PathBuf};
+
+use motorcal::discover::{DiscoverSettings, discover};
+use motorcal::study::Problem;
+
+fn case_dir(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fixtures/cases")
+        .join(name)
+}
+
+/// The effect the case conceals, as its answer.json names it.
+fn concealed_effect(dir: &Path) -> String {
+    let text = std::fs::read_to_string(dir.join("answer.json")).expect("answer.json");
+    let answer: serde_json::Value = serde_json::from_str(&text).expect("answer.json parses");
+    answer["effect"].as_str().expect("effect").to_owned()
+}
+
+fn names_the_concealed_effect(name: &str) {
+    let dir = case_dir(name);
+    let truth = concealed_effect(&dir);
+    assert_eq!(truth, name, "the case directory is named after its effect");
+    let problem = Problem::from_files(&[dir.join("recording.csv")], &dir.join("motor.toml"))
+        .expect("the case reads");
+    let mut settings = DiscoverSettings {
+        rank_only: true,
+        ..DiscoverSettings::default()
+    };
+    settings.run.quiet = true;
+    let diagnosis = discover(&problem, &settings).expect("discover runs");
+    let top: Vec<String> = diagnosis
+        .ranking
+        .iter()
+        .take(3)
+        .map(|r| format!("{} ({:.1})", r.effect, r.score))
+        .collect();
+    eprintln!("{name}: selected {}, top {top:?}", diagnosis.selected);
+    assert_eq!(
+        diagnosis.selected, truth,
+        "{name}: selected {} (ranking {top:?})",
+        diagnosis.selected
+    );
+}
+
+#[test]
+fn discover_names_a_concealed_coulomb_friction() {
+    names_the_concealed_effect("coulomb_friction");
+}
+
+#[test]
+fn discover_names_a_concealed_torque_constant_error() {
+    names_the_concealed_effect("torque_constant");
+}
