@@ -6,7 +6,7 @@ use num_dual::{Dual64, DualNum, DualSVec64};
 
 use crate::motor::{MotorModel, Segments};
 use crate::ode::{self, OdeError, SolverSettings, SolverStats};
-use crate::parameter::ParameterSpec;
+use crate::parameter::{ParamId, ParameterSpec};
 
 /// G(θ) for one recording: which parameters are free, at which times the channels are sampled.
 #[derive(Clone, Debug)]
@@ -37,15 +37,16 @@ impl ForwardModel {
         if times[0] < T0 || times.windows(2).any(|w| !(w[1] > w[0])) {
             return Err("sample times must be non-negative and strictly increasing".into());
         }
+        let ids = model.parameter_ids();
         let names = model.parameter_names();
         let calibrated = calibrated
             .iter()
             .map(|name| {
-                let name = name.as_ref();
-                let index = names.iter().position(|n| n == name).ok_or_else(|| {
-                    format!("unknown parameter '{name}' (known: {})", names.join(", "))
+                let id = ParamId::parse(name.as_ref());
+                let index = ids.iter().position(|p| *p == id).ok_or_else(|| {
+                    format!("unknown parameter '{id}' (known: {})", names.join(", "))
                 })?;
-                model.check_calibrated(name)?;
+                model.check_calibrated(&id)?;
                 Ok(index)
             })
             .collect::<Result<Vec<_>, String>>()?;

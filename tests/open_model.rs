@@ -10,7 +10,7 @@ use motorcal::density::{DensityError, FisherMetric, LogDensity, StartingPoint};
 use motorcal::diagnostics::ParameterSummary;
 use motorcal::io::{Recording, write_recording};
 use motorcal::motor::{ActiveTerm, MotorModel, MotorParameters, Term, VoltageInput};
-use motorcal::parameter::{ParameterSpec, Prior, Support};
+use motorcal::parameter::{ParamId, ParameterSpec, Prior, Support};
 use motorcal::pipeline::{RunSettings, SamplerKind, run_sampler};
 use motorcal::sampler::ChainSettings;
 use motorcal::synthetic::{generate, sample_times};
@@ -315,7 +315,7 @@ impl StartingPoint for PriorAlone {
 #[test]
 fn each_prior_family_sampled_through_its_transform_has_the_priors_moments() {
     let spec = |support: Support| ParameterSpec {
-        name: "term.p".into(),
+        id: ParamId::of_term("term", "p"),
         unit: "1",
         nominal: 0.0,
         support,
@@ -434,7 +434,7 @@ fn the_laplace_evidence_does_not_depend_on_the_coordinate_r_is_sampled_in() {
     let settings = ModelSettings::bm1();
     let plain = map_estimate(&mut problem.posterior(&settings).unwrap()).unwrap();
     problem.model.calibrate = Some(vec![CalibrateEntry {
-        name: "R".into(),
+        id: ParamId::base("R"),
         prior: Some(Prior::Normal {
             mean: 0.1,
             sd: 0.02,

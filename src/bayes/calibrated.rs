@@ -5,11 +5,13 @@
 //! absent friction) is a coordinate like any other, and no sampler meets a wall. Schema-1 models
 //! keep R's original parameterisation (x itself, a wall at 0) so that their draws do not move.
 
-use crate::parameter::{ParameterSpec, Prior, Support, Transform, column_name};
+use crate::parameter::{ParamId, ParameterSpec, Prior, Support, Transform};
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct CalibratedParameter {
-    /// The model's name (`R`, `coulomb_friction.T_c`).
+    /// Which parameter.
+    pub id: ParamId,
+    /// Its text, the model's name for it (`R`, `coulomb_friction.T_c`), as reports key it.
     pub name: String,
     pub unit: &'static str,
     pub prior: Prior,
@@ -47,11 +49,11 @@ impl CalibratedParameter {
         let prior = prior.unwrap_or(spec.default_prior);
         prior
             .validate()
-            .map_err(|e| format!("{}: prior {e}", spec.name))?;
+            .map_err(|e| format!("{}: prior {e}", spec.id))?;
         let support = spec
             .support
             .intersect(&prior.support())
-            .map_err(|e| format!("{}: {e}", spec.name))?;
+            .map_err(|e| format!("{}: {e}", spec.id))?;
         let start = if support.interior(spec.nominal) {
             spec.nominal
         } else {
@@ -60,7 +62,7 @@ impl CalibratedParameter {
                 return Err(format!(
                     "{}: neither the nominal value {} nor the prior's median {median} lies \
                      inside the support {}",
-                    spec.name,
+                    spec.id,
                     spec.nominal,
                     support.describe()
                 ));
@@ -68,7 +70,8 @@ impl CalibratedParameter {
             median
         };
         Ok(Self {
-            name: spec.name.clone(),
+            id: spec.id.clone(),
+            name: spec.name(),
             unit: spec.unit,
             prior,
             support,
@@ -80,7 +83,8 @@ impl CalibratedParameter {
     /// The parameterisation of schema-1 models: x itself, zero density outside the support.
     pub fn untransformed(spec: &ParameterSpec, prior: Prior) -> Self {
         Self {
-            name: spec.name.clone(),
+            id: spec.id.clone(),
+            name: spec.name(),
             unit: spec.unit,
             prior,
             support: spec.support,
@@ -91,7 +95,7 @@ impl CalibratedParameter {
 
     /// The name in draws files and summaries (constrained).
     pub fn output_name(&self) -> String {
-        column_name(&self.name)
+        self.id.column_name()
     }
 
     /// The name of the unconstrained coordinate (`log_R`, `logit_load_step__t_s`).
@@ -138,7 +142,7 @@ mod tests {
 
     fn spec(nominal: f64, support: Support) -> ParameterSpec {
         ParameterSpec {
-            name: "term.p".into(),
+            id: ParamId::of_term("term", "p"),
             unit: "1",
             nominal,
             support,

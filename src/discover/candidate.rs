@@ -18,7 +18,7 @@ use crate::bayes::{CalibrationPosterior, ModelSettings};
 use crate::density::LogDensity;
 use crate::error::Error;
 use crate::optimize::{MapEstimate, MapSettings, find_map};
-use crate::parameter::Support;
+use crate::parameter::{ParamId, Support};
 use crate::study::{BOUNDED_STARTS, Problem};
 
 use super::coincide::{InputCoincidence, coincidence};
@@ -71,7 +71,7 @@ impl Candidate {
     pub fn fitted_problem(&self) -> Problem {
         let mut problem = self.problem.clone();
         for (name, &value) in &self.theta {
-            problem.model.set_value(name, value);
+            problem.model.set_value(&ParamId::parse(name), value);
         }
         problem
     }
@@ -104,7 +104,7 @@ pub fn fit_candidate_from(
     let added_names: Vec<String> = posterior
         .calibrated()
         .iter()
-        .filter(|c| added.iter().any(|t| c.name.starts_with(&format!("{t}."))))
+        .filter(|c| added.iter().any(|t| c.id.is_of(t)))
         .map(|c| c.name.clone())
         .collect();
     let n_added = added_names.len();
@@ -181,7 +181,7 @@ fn best_map(
     for (i, c) in posterior.calibrated().iter().enumerate() {
         if matches!(c.support, Support::Positive)
             && known(&c.name).is_none()
-            && c.name.contains('.')
+            && c.id.term().is_some()
         {
             for factor in POSITIVE_START_FACTORS {
                 let mut s = start.clone();
@@ -242,18 +242,19 @@ fn best_map(
 pub fn answer_params(fit: &Candidate) -> BTreeMap<String, Option<f64>> {
     let mut out = BTreeMap::new();
     for (name, &value) in &fit.theta {
-        let key = match name.split_once('.') {
-            Some((term, key)) if fit.added.iter().any(|t| t == term) && fit.added.len() == 1 => {
-                key.to_string()
+        let id = ParamId::parse(name);
+        let key = match id.term() {
+            Some(term) if fit.added.iter().any(|t| t == term) && fit.added.len() == 1 => {
+                id.key().to_string()
             }
             _ => name.clone(),
         };
         out.insert(key, Some(value));
-        if name == "armature_reaction.kappa" {
+        if id == ParamId::of_term("armature_reaction", "kappa") {
             let key = if fit.added.len() == 1 {
                 "I_sat".to_string()
             } else {
-                "armature_reaction.I_sat".to_string()
+                ParamId::of_term("armature_reaction", "I_sat").to_string()
             };
             out.insert(key, (value > 0.0).then(|| 1.0 / value));
         }

@@ -215,9 +215,10 @@ pub fn coincidence(
         .enumerate()
         .filter(|(_, c)| {
             matches!(c.support, Support::Bounded { .. })
-                && c.name.split_once('.').is_some_and(|(term, _)| {
-                    crate::motor::Term::named(term).is_some_and(|t| t.record_time())
-                })
+                && c.id
+                    .term()
+                    .and_then(crate::motor::Term::named)
+                    .is_some_and(|t| t.record_time())
         })
         .map(|(i, c)| (i, c.name.clone()))
         .collect();

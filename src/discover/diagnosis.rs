@@ -10,6 +10,7 @@ use serde::Serialize;
 use crate::bayes::ModelSettings;
 use crate::error::Error;
 use crate::io::ModelFile;
+use crate::parameter::ParamId;
 use crate::plot::MissingTorqueCurve;
 use crate::study::Problem;
 
@@ -418,7 +419,7 @@ fn sampled_fits(
     // The posterior means as the model file's values.
     let mut model = after_problem.model.clone();
     for (name, &value) in diagnosis.fit_after.iter().flat_map(|f| &f.params_mean) {
-        model.set_value(name, value);
+        model.set_value(&ParamId::parse(name), value);
     }
     diagnosis.amended_model = Some(model);
     Ok(())
@@ -430,6 +431,6 @@ fn parameter_units(p: &Problem) -> Result<BTreeMap<String, String>, Error> {
     Ok(model
         .parameter_specs(&model.magnitudes(1.0))
         .into_iter()
-        .map(|spec| (spec.name, spec.unit.to_string()))
+        .map(|spec| (spec.name(), spec.unit.to_string()))
         .collect())
 }

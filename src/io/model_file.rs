@@ -17,6 +17,7 @@ use super::toml_lines::{key_paths, table_headers, toml_error};
 use crate::motor::{
     ActiveTerm, Base, DriveSettings, MotorModel, MotorParam, MotorParameters, VoltageInput,
 };
+use crate::parameter::ParamId;
 
 /// The newest model-file format version this build reads and writes. Schema 1 (the motor and
 /// the channels) is still read, and means what it always meant.
@@ -82,11 +83,11 @@ impl ModelFile {
         Ok(model.with_drive(drive))
     }
 
-    /// Sets a parameter's nominal value by the model's name for it (`R`, `coulomb_friction.T_c`);
-    /// false when the motor has no such parameter or the term is not on.
-    pub fn set_value(&mut self, name: &str, value: f64) -> bool {
-        match name.split_once('.') {
-            Some((term, key)) => {
+    /// Sets a parameter's nominal value (`R`, `coulomb_friction.T_c`); false when the motor has
+    /// no such parameter or the term is not on.
+    pub fn set_value(&mut self, id: &ParamId, value: f64) -> bool {
+        match id {
+            ParamId::Term { term, key } => {
                 let Some(active) = self.terms.iter_mut().find(|t| t.term.name() == term) else {
                     return false;
                 };
@@ -96,7 +97,7 @@ impl ModelFile {
                 active.values[i] = value;
                 true
             }
-            None => match MotorParam::from_key(name) {
+            ParamId::Base(key) => match MotorParam::from_key(key) {
                 Some(p) => {
                     self.motor.set(p, value);
                     true

@@ -10,12 +10,13 @@ use serde::Deserialize;
 use super::error::InputError;
 use crate::bayes::BasisKind;
 use crate::motor::{ActiveTerm, MotorParam, Term};
-use crate::parameter::Prior;
+use crate::parameter::{ParamId, Prior};
 
 /// A parameter the model file calibrates, with its prior (`None`: the term's default).
 #[derive(Clone, Debug, PartialEq)]
 pub struct CalibrateEntry {
-    pub name: String,
+    /// The parameter, as the file names it (`R`, `"coulomb_friction.T_c"`).
+    pub id: ParamId,
     pub prior: Option<Prior>,
 }
 
@@ -120,13 +121,13 @@ pub(super) fn parse_terms(
 }
 
 /// Whether `name` is a parameter of the base model or of a term (term on or not).
-fn check_parameter_name(name: &str) -> Result<(), String> {
-    if name == "T_L" {
-        return Err("T_L is not a parameter of its own: calibrate load_torque.T_0".into());
-    }
-    match name.split_once('.') {
-        None if MotorParam::from_key(name).is_some() => Ok(()),
-        None => Err(format!(
+fn check_parameter_name(name: &ParamId) -> Result<(), String> {
+    match name {
+        ParamId::Base(key) if key == "T_L" => {
+            Err("T_L is not a parameter of its own: calibrate load_torque.T_0".into())
+        }
+        ParamId::Base(key) if MotorParam::from_key(key).is_some() => Ok(()),
+        ParamId::Base(_) => Err(format!(
             "unknown parameter '{name}' (the motor's are {}; a term's are written term.key)",
             MotorParam::ALL
                 .iter()
@@ -134,7 +135,7 @@ fn check_parameter_name(name: &str) -> Result<(), String> {
                 .collect::<Vec<_>>()
                 .join(", ")
         )),
-        Some((term, key)) => match Term::declarations(term) {
+        ParamId::Term { term, key } => match Term::declarations(term) {
             None => Err(format!(
                 "unknown term '{term}' (known: {})",
                 Term::NAMES.join(", ")
@@ -157,7 +158,7 @@ const FAMILIES: [(&str, [&str; 2]); 4] = [
 ];
 
 fn parse_prior(
-    name: &str,
+    name: &ParamId,
     entry: &toml::Table,
     file: &std::path::Path,
     locate: Locate,
@@ -254,7 +255,7 @@ pub(super) fn parse_calibrate(
     file: &std::path::Path,
     locate: Locate,
 ) -> Result<Vec<CalibrateEntry>, InputError> {
-    let mut flat: Vec<(String, &toml::Value)> = Vec::new();
+    let mut flat: Vec<(ParamId, &toml::Value)> = Vec::new();
     for (key, value) in table {
         let nested = Term::declarations(key).is_some()
             && value
@@ -262,10 +263,10 @@ pub(super) fn parse_calibrate(
                 .is_some_and(|t| !t.is_empty() && t.values().all(|v| v.is_table()));
         if nested {
             for (sub, v) in value.as_table().expect("checked") {
-                flat.push((format!("{key}.{sub}"), v));
+                flat.push((ParamId::of_term(key, sub), v));
             }
         } else {
-            flat.push((key.clone(), value));
+            flat.push((ParamId::parse(key), value));
         }
     }
     let mut entries = Vec::new();
@@ -284,14 +285,14 @@ pub(super) fn parse_calibrate(
             ));
         };
         let prior = parse_prior(&name, entry, file, locate)?;
-        if let Some((term, _)) = name.split_once('.')
+        if let Some(term) = name.term()
             && !terms.iter().any(|t| t.term.name() == term)
         {
             terms.push(ActiveTerm::with_defaults(
                 Term::named(term).expect("checked above"),
             ));
         }
-        entries.push(CalibrateEntry { name, prior });
+        entries.push(CalibrateEntry { id: name, prior });
     }
     Ok(entries)
 }
@@ -400,7 +401,7 @@ pub(super) fn write_tables(
                     toml_number(other.variance().sqrt())
                 ),
             };
-            let _ = writeln!(out, "\"{}\" = {{{args}}}", e.name);
+            let _ = writeln!(out, "\"{}\" = {{{args}}}", e.id);
         }
     }
     if let Some(d) = discrepancy {

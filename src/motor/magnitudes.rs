@@ -2,7 +2,7 @@
 //! of a parameter means for this machine and this record.
 
 use super::{MotorModel, MotorParam, VoltageInput};
-use crate::parameter::{ParameterSpec, Prior, Support};
+use crate::parameter::{ParamId, ParameterSpec, Prior, Support};
 
 /// The scales of a model, from its nominal values and the record's length: what a "small" or
 /// "large" value of a term's parameter means for this machine. A default prior puts one
@@ -83,7 +83,7 @@ impl MotorModel {
         for t in &self.terms {
             for (decl, &value) in t.term.params().iter().zip(&t.values) {
                 specs.push(ParameterSpec {
-                    name: format!("{}.{}", t.term.name(), decl.key),
+                    id: ParamId::of_term(t.term.name(), decl.key),
                     unit: self.base.unit(decl.unit),
                     nominal: value,
                     support: (decl.support)(magnitudes),
@@ -128,7 +128,7 @@ fn base_spec(p: MotorParam, nominal: f64, m: &Magnitudes) -> ParameterSpec {
         InitialSpeed => (Support::Real, normal(PRIOR_SHARE * m.speed)),
     };
     ParameterSpec {
-        name: p.key().to_string(),
+        id: ParamId::base(p.key()),
         unit: p.unit(),
         nominal,
         support,

@@ -28,6 +28,8 @@ pub use terms::Term;
 
 use num_dual::DualNum;
 
+use crate::parameter::ParamId;
+
 /// The number types the physics is written for: `f64` and num-dual's dual numbers.
 pub trait Scalar: DualNum<Primitive = f64> + Copy {}
 impl<D: DualNum<Primitive = f64> + Copy> Scalar for D {}
@@ -149,17 +151,25 @@ impl MotorModel {
         &self.terms
     }
 
-    /// Names of the parameter vector: the base's keys, then `term.key` for each term's.
-    pub fn parameter_names(&self) -> Vec<String> {
+    /// The parameter vector's identities: the base's, then each term's.
+    pub fn parameter_ids(&self) -> Vec<ParamId> {
         MotorParam::ALL
             .iter()
-            .map(|p| p.key().to_string())
+            .map(|p| ParamId::base(p.key()))
             .chain(self.terms.iter().flat_map(|t| {
                 t.term
                     .params()
                     .iter()
-                    .map(move |p| format!("{}.{}", t.term.name(), p.key))
+                    .map(move |p| ParamId::of_term(t.term.name(), p.key))
             }))
+            .collect()
+    }
+
+    /// Names of the parameter vector: the base's keys, then `term.key` for each term's.
+    pub fn parameter_names(&self) -> Vec<String> {
+        self.parameter_ids()
+            .iter()
+            .map(ParamId::to_string)
             .collect()
     }
 
@@ -172,8 +182,8 @@ impl MotorModel {
             .collect()
     }
 
-    pub fn parameter_index(&self, name: &str) -> Option<usize> {
-        self.parameter_names().iter().position(|n| n == name)
+    pub fn parameter_index(&self, id: &ParamId) -> Option<usize> {
+        self.parameter_ids().iter().position(|p| p == id)
     }
 
     /// The model driven by a record's sampled input (a drive base).
@@ -196,12 +206,12 @@ impl MotorModel {
     }
 
     /// Why a parameter cannot be calibrated, if it cannot (e.g. the time of a hard step).
-    pub fn check_calibrated(&self, name: &str) -> Result<(), String> {
-        let Some((term_name, key)) = name.split_once('.') else {
+    pub fn check_calibrated(&self, id: &ParamId) -> Result<(), String> {
+        let Some(term_name) = id.term() else {
             return Ok(());
         };
         match self.terms.iter().find(|t| t.term.name() == term_name) {
-            Some(t) => t.term.check_calibrated(key),
+            Some(t) => t.term.check_calibrated(id.key()),
             None => Ok(()),
         }
     }

@@ -4,8 +4,10 @@
 //! This sits below both the physics (which declares parameters) and the Bayesian model (which
 //! puts densities on them), so that neither has to import the other.
 
+mod id;
 mod prior;
 
+pub use id::ParamId;
 pub use prior::{Prior, ln_gamma};
 
 use serde::{Deserialize, Serialize};
@@ -83,9 +85,9 @@ impl Support {
 /// A parameter as a model declares it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ParameterSpec {
-    /// The key in model files and reports: `R` for a base parameter, `coulomb_friction.T_c`
-    /// for a term's.
-    pub name: String,
+    /// Which parameter; its text is the key in model files and reports: `R` for a base
+    /// parameter, `coulomb_friction.T_c` for a term's.
+    pub id: ParamId,
     pub unit: &'static str,
     pub nominal: f64,
     pub support: Support,
@@ -95,16 +97,15 @@ pub struct ParameterSpec {
 }
 
 impl ParameterSpec {
-    /// The name in draws files: ArviZ reads a dot as an array index, so a term's parameter
-    /// `coulomb_friction.T_c` is written `coulomb_friction__T_c`.
-    pub fn column_name(&self) -> String {
-        column_name(&self.name)
+    /// The key in model files and reports (`R`, `coulomb_friction.T_c`).
+    pub fn name(&self) -> String {
+        self.id.to_string()
     }
-}
 
-/// `term.key` → `term__key`; base names are unchanged.
-pub fn column_name(name: &str) -> String {
-    name.replace('.', "__")
+    /// The name in draws files (`coulomb_friction__T_c`): see [`ParamId::column_name`].
+    pub fn column_name(&self) -> String {
+        self.id.column_name()
+    }
 }
 
 /// The map from an unconstrained coordinate u to the parameter x.

@@ -6,8 +6,9 @@ use std::path::{Path, PathBuf};
 use crate::bayes::{CalibratedParameter, CalibrationPosterior, ModelSettings, Observations};
 use crate::forward::ForwardModel;
 use crate::io::{CalibrateEntry, ModelFile, Recording, read_model_file, read_recording_for};
-use crate::motor::{ActiveTerm, MotorModel, MotorParameters, Term, VoltageInput};
+use crate::motor::{ActiveTerm, MotorModel, MotorParam, MotorParameters, Term, VoltageInput};
 use crate::ode::SolverSettings;
+use crate::parameter::ParamId;
 use crate::synthetic::{PaperSetup, SyntheticData, paper_measurements};
 
 use crate::error::Error;
@@ -120,9 +121,9 @@ impl Problem {
             .iter()
             .map(|e| {
                 model
-                    .parameter_index(&e.name)
-                    .map(|i| (i, e.name.clone()))
-                    .ok_or_else(|| Error::invalid(format!("unknown parameter '{}'", e.name)))
+                    .parameter_index(&e.id)
+                    .map(|i| (i, e.id.to_string()))
+                    .ok_or_else(|| Error::invalid(format!("unknown parameter '{}'", e.id)))
             })
             .collect::<Result<_, _>>()?;
         names.sort();
@@ -177,7 +178,7 @@ impl Problem {
         let mut calibrate = match &base.model.calibrate {
             Some(entries) => entries.clone(),
             None => vec![CalibrateEntry {
-                name: "R".into(),
+                id: ParamId::base(MotorParam::Resistance.key()),
                 prior: None,
             }],
         };
@@ -196,7 +197,7 @@ impl Problem {
             })?;
             for p in term.params() {
                 calibrate.push(CalibrateEntry {
-                    name: format!("{name}.{}", p.key),
+                    id: ParamId::of_term(name, p.key),
                     prior: None,
                 });
             }
@@ -275,7 +276,7 @@ impl Problem {
             .map(|spec| {
                 let prior = entries
                     .iter()
-                    .find(|e| e.name == spec.name)
+                    .find(|e| e.id == spec.id)
                     .and_then(|e| e.prior);
                 CalibratedParameter::new(spec, prior)
                     .map_err(|e| Error::invalid(format!("{}: {e}", self.label)))

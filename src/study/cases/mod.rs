@@ -20,7 +20,7 @@ use crate::error::Error;
 use crate::io::{ModelFile, Recording};
 use crate::motor::{MotorParam, Term, VoltageInput};
 use crate::ode::SolverSettings;
-use crate::parameter::Support;
+use crate::parameter::{ParamId, Support};
 use crate::study::InputProfile;
 use crate::study::Problem;
 use crate::synthetic::sample_times;
@@ -423,7 +423,7 @@ fn assemble_case(
         let term = Term::named(name).expect("checked");
         for (p, v) in term.params().iter().zip(values) {
             let key = if qualify {
-                format!("{name}.{}", p.key)
+                ParamId::of_term(name, p.key).to_string()
             } else {
                 p.key.to_string()
             };
