@@ -36,7 +36,7 @@ fn diagnose_load_step_at(t_s: f64, noise_sd: [f64; 2], name: &str) -> Diagnosis 
         out: dir.clone(),
         seed: 11,
         input: InputProfile::Reversal,
-        noise_sd,
+        noise_sd: noise_sd.to_vec(),
         ..SimulateOptions::default()
     })
     .unwrap();
