@@ -1,257 +1,162 @@
-//! `motorcal bench`: effective samples per second of every sampler across K, measured side by
-//! side on the same data and seeds.
+//! `motorcal bench`: its options, the measuring by the library (`paper::bench`), and its files
+//! (`bench.json`, `bench.csv`, the ESS-per-second figures) and table.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
-use serde::{Deserialize, Serialize};
-
-use crate::bayes::ModelSettings;
+use crate::bayes::CoefficientFamily;
+use crate::error::Error;
 use crate::plot::{self, SamplerCurve};
-use crate::sampler::ChainSettings;
-use crate::synthetic::DEFAULT_SEED;
 
 use super::AppError;
-use super::run::{
-    MetricAdaptation, RunCost, RunOutput, RunSettings, SamplerKind, default_warmup, ratio_2sf,
-    run_sampler,
+use super::args::{ChainArgs, coefficient_prior, parse_ks};
+use super::run::{SamplerKind, ratio_2sf};
+
+pub use crate::paper::bench::{
+    BenchOptions, BenchRecord, DEFAULT_KS, MAX_BASELINE_DRAWS, MAX_GRADIENT_DRAWS,
 };
-use crate::study::Problem;
 
-/// The K values of the study unless told otherwise.
-pub const DEFAULT_KS: [usize; 7] = [0, 3, 6, 9, 12, 15, 20];
-/// The paper ran 100000 draws per chain; an unconverged baseline is extended up to this.
-pub const MAX_BASELINE_DRAWS: usize = 100_000;
-/// Gradient samplers are extended up to this many draws when they have not converged.
-pub const MAX_GRADIENT_DRAWS: usize = 16_000;
-
-#[derive(Clone, Debug, Serialize)]
-pub struct BenchOptions {
-    pub ks: Vec<usize>,
+#[derive(clap::Args, Clone, Debug)]
+pub struct BenchArgs {
+    /// Discrepancy degrees: a comma list or a range (0..=20).
+    #[arg(long, default_value = "0,3,6,9,12,15,20")]
+    pub k: String,
+    /// Samplers, comma separated (default: all).
+    #[arg(long, value_enum, value_delimiter = ',')]
     pub samplers: Vec<SamplerKind>,
-    /// Thread counts to measure at (1 is the per-core figure).
+    /// Thread counts, comma separated (default: 1 and all cores): the bench measures each, so
+    /// unlike the other commands it takes a list.
+    #[arg(long, value_delimiter = ',')]
     pub threads: Vec<usize>,
-    pub chains: usize,
-    /// Draws per chain of the first attempt (default per sampler when `None`).
+    #[command(flatten)]
+    pub chains: ChainArgs,
+    /// Draws per chain (default: per sampler, extended until converged).
+    #[arg(long)]
     pub draws: Option<usize>,
+    #[arg(long)]
     pub warmup: Option<usize>,
-    pub seed: u64,
+    /// A recording to bench on instead of the paper's data (with --model).
+    #[arg(long)]
     pub data: Option<PathBuf>,
+    #[arg(long)]
     pub model: Option<PathBuf>,
+    #[arg(long, default_value = "out/bench")]
     pub out: PathBuf,
+    /// Write the records as JSON here (default: OUT/bench.json).
+    #[arg(long)]
     pub json: Option<PathBuf>,
-    pub quiet: bool,
-    /// Redraw the table and figures from an earlier run's JSON instead of measuring.
+    /// Redraw the table, CSV and figures from an earlier run's bench.json (no measuring).
+    #[arg(long)]
     pub from_json: Option<PathBuf>,
-    /// The discrepancy coefficients' prior (§5's decaying variance, or the paper's).
-    pub coefficient_prior: crate::bayes::CoefficientPrior,
-    /// How HMC and NUTS tune their metric in warm-up.
-    pub metric_adaptation: MetricAdaptation,
+    /// Decay power p of the coefficient prior variance V0/(j+1)^p (0: the paper's prior).
+    #[arg(long, default_value_t = 0.0)]
+    pub prior_decay: f64,
+    #[arg(long, value_enum, default_value_t = CoefficientFamily::Laplace)]
+    pub prior_family: CoefficientFamily,
 }
 
-impl Default for BenchOptions {
-    fn default() -> Self {
-        Self {
-            ks: DEFAULT_KS.to_vec(),
-            samplers: SamplerKind::ALL.to_vec(),
-            threads: vec![
-                1,
-                std::thread::available_parallelism().map_or(1, |n| n.get()),
-            ],
-            chains: 4,
-            draws: None,
-            warmup: None,
-            seed: DEFAULT_SEED,
-            data: None,
-            model: None,
-            out: PathBuf::from("out/bench"),
-            json: None,
-            quiet: false,
-            from_json: None,
-            coefficient_prior: crate::bayes::CoefficientPrior::default(),
-            metric_adaptation: MetricAdaptation::default(),
-        }
+impl BenchArgs {
+    /// The library's options: a list not given is the library's default.
+    pub fn options(&self) -> Result<BenchOptions, AppError> {
+        let defaults = BenchOptions::default();
+        Ok(BenchOptions {
+            ks: parse_ks(&self.k).map_err(|e| AppError::Usage(format!("--k {e}")))?,
+            samplers: or_default(&self.samplers, defaults.samplers),
+            threads: or_default(&self.threads, defaults.threads),
+            chains: self.chains.chains_or(defaults.chains),
+            draws: self.draws,
+            warmup: self.warmup,
+            seed: self.chains.seed,
+            data: self.data.clone(),
+            model: self.model.clone(),
+            quiet: self.chains.quiet,
+            coefficient_prior: coefficient_prior(self.prior_family, self.prior_decay),
+            metric_adaptation: self.chains.metric_adaptation.unwrap_or_default(),
+        })
     }
 }
 
-/// One (sampler, K, threads) measurement: the stable contract of `--json`. The cost and the
-/// speed figures (`wall_s`, `min_ess_per_s`, `min_ess_per_total_s`, …) are [`RunCost`]'s,
-/// written at the record's top level.
-#[derive(Clone, Debug, Serialize, Deserialize)]
-pub struct BenchRecord {
-    pub sampler: String,
-    pub k: usize,
-    pub threads: usize,
-    pub chains: usize,
-    pub warmup: usize,
-    pub draws: usize,
-    pub min_ess_bulk: f64,
-    pub max_rhat: f64,
-    /// R-hat ≤ 1.01 and min bulk-ESS ≥ 100.
-    pub converged: bool,
-    /// The run did not converge even at the longest length tried: its ESS is not to be
-    /// trusted (it overstates the sampler), so ratios against it are lower bounds.
-    pub lower_bound: bool,
-    pub divergences: usize,
-    #[serde(flatten)]
-    pub cost: RunCost,
-    /// The coefficient prior the run used (empty in files written before it was recorded).
-    #[serde(default)]
-    pub prior: String,
-    /// How HMC and NUTS tuned their metric ("laplace" or "windows"; empty for the other
-    /// samplers and in files written before it was recorded).
-    #[serde(default)]
-    pub metric_adaptation: String,
-}
-
-fn first_attempt(sampler: SamplerKind, options: &BenchOptions) -> ChainSettings {
-    let (warmup, draws) = match sampler {
-        SamplerKind::Metropolis => (500, 5000),
-        SamplerKind::AdaptiveMetropolis => (5000, 5000),
-        _ => (default_warmup(sampler, options.metric_adaptation), 1000),
-    };
-    ChainSettings {
-        warmup: options.warmup.unwrap_or(warmup),
-        draws: options.draws.unwrap_or(draws),
-        keep: None,
-    }
-}
-
-fn converged(run: &RunOutput) -> bool {
-    run.max_rhat <= 1.01 && run.min_ess_bulk >= 100.0
-}
-
-/// Runs a sampler, four times longer each time it has not converged, up to its cap.
-fn run_until_converged(
-    posterior: &mut crate::bayes::CalibrationPosterior,
-    sampler: SamplerKind,
-    threads: usize,
-    options: &BenchOptions,
-    label: &str,
-) -> Result<(RunOutput, ChainSettings), AppError> {
-    let cap = if sampler.uses_gradient() {
-        MAX_GRADIENT_DRAWS
+/// `given`, or `default` when the flag was not given.
+fn or_default<T: Clone>(given: &[T], default: Vec<T>) -> Vec<T> {
+    if given.is_empty() {
+        default
     } else {
-        MAX_BASELINE_DRAWS
-    };
-    let mut chain = first_attempt(sampler, options);
-    loop {
-        let settings = RunSettings {
-            sampler,
-            chains: options.chains,
-            chain: chain.clone(),
-            seed: options.seed,
-            threads: Some(threads),
-            quiet: options.quiet,
-            metric_adaptation: options.metric_adaptation,
-            ..RunSettings::default()
-        };
-        let run = run_sampler(posterior, &settings, label)?;
-        if converged(&run) || chain.draws >= cap || options.draws.is_some() {
-            return Ok((run, chain));
-        }
-        chain.draws = (chain.draws * 4).min(cap);
+        given.to_vec()
     }
 }
 
-fn record(
-    sampler: SamplerKind,
-    k: usize,
-    threads: usize,
+/// Where the files go, and what the figures draw: the samplers and thread counts, in order.
+struct Outputs {
+    out: PathBuf,
+    json: Option<PathBuf>,
+    samplers: Vec<SamplerKind>,
+    threads: Vec<usize>,
     chains: usize,
-    chain: &ChainSettings,
-    run: &RunOutput,
-) -> BenchRecord {
-    let ok = converged(run);
-    BenchRecord {
-        sampler: sampler.name().into(),
-        k,
-        threads,
-        chains,
-        warmup: chain.warmup,
-        draws: chain.draws,
-        min_ess_bulk: run.min_ess_bulk,
-        max_rhat: run.max_rhat,
-        converged: ok,
-        lower_bound: !ok,
-        divergences: run.divergences,
-        cost: RunCost::of(run, sampler.uses_gradient()),
-        prior: crate::bayes::CoefficientPrior::default().label(),
-        metric_adaptation: String::new(),
+}
+
+/// The whole command: measure (or read `--from-json`), write, print the table.
+pub fn run(args: &BenchArgs) -> Result<(), AppError> {
+    let options = args.options()?;
+    let mut outputs = Outputs {
+        out: args.out.clone(),
+        json: args.json.clone(),
+        samplers: options.samplers.clone(),
+        threads: options.threads.clone(),
+        chains: options.chains,
+    };
+    let records = match &args.from_json {
+        Some(path) => {
+            let records = read_records(path)?;
+            outputs.threads = records.iter().map(|r| r.threads).collect();
+            outputs.threads.sort();
+            outputs.threads.dedup();
+            records
+        }
+        None => crate::paper::bench::bench_with(&options, |records| {
+            let r = records.last().expect("called after each record");
+            if !options.quiet {
+                eprintln!("{}", format_record(r));
+            }
+            // Written after every record: a long bench that is stopped keeps what it measured.
+            write_records(&outputs, records).map_err(|e| match e {
+                AppError::Output(m) => Error::Output(m),
+                e => Error::Output(e.to_string()),
+            })
+        })
+        .map_err(flag_error)?,
+    };
+    write_outputs(&outputs, &records)?;
+    print!("{}", format_table(&records));
+    println!(
+        "wrote {}/bench.csv, bench.json and ess_per_*.png",
+        args.out.display()
+    );
+    Ok(())
+}
+
+/// The library's refusals, in the words the bench has always used for these two.
+fn flag_error(e: Error) -> AppError {
+    match e {
+        Error::Settings(s) if s.name == "threads/chains" => {
+            AppError::Usage("--threads and --chains must be at least 1".into())
+        }
+        Error::Settings(s) if s.name == "data/model" => {
+            AppError::Usage("--data and --model go together".into())
+        }
+        e => e.into(),
     }
 }
 
-pub fn bench(options: &BenchOptions) -> Result<Vec<BenchRecord>, AppError> {
-    if let Some(path) = &options.from_json {
-        let text = std::fs::read_to_string(path).map_err(|e| {
-            AppError::Input(crate::io::InputError::new(
-                path,
-                format!("cannot read: {e}"),
-            ))
-        })?;
-        let records: Vec<BenchRecord> = serde_json::from_str(&text).map_err(|e| {
-            AppError::Input(crate::io::InputError::new(path, e.to_string()).at_line(e.line()))
-        })?;
-        let mut options = options.clone();
-        options.threads = records.iter().map(|r| r.threads).collect();
-        options.threads.sort();
-        options.threads.dedup();
-        write_outputs(&options, &records)?;
-        return Ok(records);
-    }
-    if options.ks.is_empty() || options.samplers.is_empty() || options.threads.is_empty() {
-        return Err(AppError::Usage(
-            "bench: name at least one K, sampler and thread count".into(),
-        ));
-    }
-    // Every K is checked up front, by the settings' own rule, before any measuring starts.
-    let settings_for = |k: usize| {
-        let mut settings = ModelSettings::bm2(k);
-        settings.coefficient_prior = options.coefficient_prior;
-        settings
-    };
-    for &k in &options.ks {
-        settings_for(k)
-            .validate()
-            .map_err(|e| AppError::Usage(format!("--k {k}: {e}")))?;
-    }
-    if options.threads.contains(&0) || options.chains == 0 {
-        return Err(AppError::Usage(
-            "--threads and --chains must be at least 1".into(),
-        ));
-    }
-    let problem = match (&options.data, &options.model) {
-        (Some(d), Some(m)) => Problem::from_files(std::slice::from_ref(d), m)?,
-        (None, None) => Problem::paper(options.seed)?,
-        _ => return Err(AppError::Usage("--data and --model go together".into())),
-    };
-    let mut records = Vec::new();
-    for &k in &options.ks {
-        let mut posterior = problem.posterior(&settings_for(k))?;
-        for &sampler in &options.samplers {
-            for &threads in &options.threads {
-                let label = format!("K={k} t={threads}");
-                let (run, chain) =
-                    run_until_converged(&mut posterior, sampler, threads, options, &label)?;
-                let r = BenchRecord {
-                    prior: options.coefficient_prior.label(),
-                    metric_adaptation: if sampler.is_hamiltonian() {
-                        options.metric_adaptation.name().into()
-                    } else {
-                        String::new()
-                    },
-                    ..record(sampler, k, threads, options.chains, &chain, &run)
-                };
-                if !options.quiet {
-                    eprintln!("{}", format_record(&r));
-                }
-                records.push(r);
-                // Written after every record: a long bench that is stopped keeps what it measured.
-                write_records(options, &records)?;
-            }
-        }
-    }
-    write_outputs(options, &records)?;
-    Ok(records)
+/// The records of an earlier run's `bench.json`.
+pub fn read_records(path: &Path) -> Result<Vec<BenchRecord>, AppError> {
+    let text = std::fs::read_to_string(path).map_err(|e| {
+        AppError::Input(crate::io::InputError::new(
+            path,
+            format!("cannot read: {e}"),
+        ))
+    })?;
+    serde_json::from_str(&text).map_err(|e| {
+        AppError::Input(crate::io::InputError::new(path, e.to_string()).at_line(e.line()))
+    })
 }
 
 fn format_record(r: &BenchRecord) -> String {
@@ -350,7 +255,7 @@ pub fn format_table(records: &[BenchRecord]) -> String {
     out
 }
 
-fn write_records(options: &BenchOptions, records: &[BenchRecord]) -> Result<(), AppError> {
+fn write_records(options: &Outputs, records: &[BenchRecord]) -> Result<(), AppError> {
     let json =
         serde_json::to_string_pretty(records).map_err(|e| AppError::Output(e.to_string()))?;
     let json_path = options
@@ -403,7 +308,7 @@ fn write_records(options: &BenchOptions, records: &[BenchRecord]) -> Result<(), 
     Ok(())
 }
 
-fn write_outputs(options: &BenchOptions, records: &[BenchRecord]) -> Result<(), AppError> {
+fn write_outputs(options: &Outputs, records: &[BenchRecord]) -> Result<(), AppError> {
     write_records(options, records)?;
     for threads in options.threads.iter().copied() {
         let curves = |value: fn(&BenchRecord) -> f64| -> Vec<SamplerCurve> {
@@ -456,86 +361,8 @@ fn write_outputs(options: &BenchOptions, records: &[BenchRecord]) -> Result<(), 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// A run with these diagnostics and `pipeline::cost`'s test costs (8 CPU-s of sampling,
-    /// 9.5 of the whole cost).
-    fn run(min_ess: f64, max_rhat: f64) -> RunOutput {
-        RunOutput {
-            max_rhat,
-            ..crate::pipeline::cost::tests::run(min_ess)
-        }
-    }
-
-    fn settings() -> ChainSettings {
-        ChainSettings {
-            warmup: 100,
-            draws: 400,
-            keep: None,
-        }
-    }
-
-    #[test]
-    fn convergence_needs_both_rhat_and_ess() {
-        assert!(converged(&run(100.0, 1.01)));
-        assert!(!converged(&run(99.9, 1.0)));
-        assert!(!converged(&run(5000.0, 1.011)));
-        assert!(!converged(&run(f64::NAN, 1.0)));
-    }
-
-    #[test]
-    fn speed_is_per_cpu_second_whatever_the_thread_count() {
-        let r = run(800.0, 1.0);
-        let at = |threads| record(SamplerKind::NutsDense, 9, threads, 4, &settings(), &r);
-        assert_eq!(at(1).cost.min_ess_per_s, 100.0);
-        assert_eq!(at(2).cost.min_ess_per_s, 100.0);
-        assert_eq!(at(1).cost.min_ess_per_total_s, 800.0 / 9.5);
-        // Gradient samplers are counted per gradient, the others per density evaluation.
-        assert_eq!(at(1).cost.eval_kind, "gradient");
-        assert_eq!(at(1).cost.min_ess_per_eval, 800.0 / 8000.0);
-        let metropolis = record(SamplerKind::Metropolis, 9, 1, 4, &settings(), &r);
-        assert_eq!(metropolis.cost.eval_kind, "density");
-        assert_eq!(metropolis.cost.min_ess_per_eval, 800.0 / 12000.0);
-    }
-
-    #[test]
-    fn the_json_is_flat_and_reads_files_written_before_the_cost_was_split() {
-        let r = record(
-            SamplerKind::NutsDense,
-            9,
-            1,
-            4,
-            &settings(),
-            &run(800.0, 1.0),
-        );
-        let v = serde_json::to_value(&r).unwrap();
-        for key in [
-            "wall_s",
-            "min_ess_per_s",
-            "min_ess_per_total_s",
-            "min_ess_per_wall_s",
-            "min_ess_per_eval",
-            "min_ess_per_all_evals",
-            "all_evaluations",
-            "sampling_cpu_s",
-            "warmup_cpu_s",
-            "map_cpu_s",
-        ] {
-            assert!(v.get(key).is_some_and(|x| x.is_number()), "{key} in {v}");
-        }
-        let back: BenchRecord = serde_json::from_value(v).unwrap();
-        assert_eq!(back.cost, r.cost);
-        // A record of papers/john2018/bench/bench.json, written before.
-        let old = r#"{"sampler": "metropolis", "k": 0, "threads": 1, "chains": 4, "warmup": 500,
-            "draws": 5000, "min_ess_bulk": 377.5, "min_ess_per_s": 275.0, "min_ess_per_eval": 0.0037,
-            "eval_kind": "density", "evaluations": 100000, "max_rhat": 1.009, "converged": true,
-            "lower_bound": false, "wall_s": 1.75, "warmup_s": 0.057, "sampling_cpu_s": 1.37,
-            "divergences": 0}"#;
-        let old: BenchRecord = serde_json::from_str(old).unwrap();
-        assert_eq!(old.cost.min_ess_per_s, 275.0);
-        assert_eq!(old.cost.warmup.wall_seconds, 0.057);
-        assert_eq!(old.cost.evaluations, 100000);
-        assert_eq!(old.prior, "");
-    }
+    use crate::paper::bench::record;
+    use crate::paper::bench::tests::{run, settings};
 
     #[test]
     fn an_unconverged_run_is_a_bound_and_its_ratios_say_so() {

@@ -9,10 +9,11 @@ use std::path::PathBuf;
 use crate::discover::{Diagnosis, DiscoverSettings, FitStage, discover};
 use crate::io::write_model_file;
 use crate::motor::Term;
-use crate::pipeline::RunSettings;
+use crate::pipeline::{RunSettings, SamplerKind};
 use crate::study::{Problem, posterior_predictive};
 
 use super::AppError;
+use super::args::ChainArgs;
 use super::figures::{plot_discrepancy, plot_predictive};
 
 pub use crate::discover::METRIC_ADAPTATION;
@@ -30,6 +31,69 @@ pub struct DiagnoseOptions {
     pub json: Option<PathBuf>,
     /// Skip the sampled fits (ranking, selection and ties only).
     pub rank_only: bool,
+}
+
+#[derive(clap::Args, Clone, Debug)]
+pub struct DiagnoseArgs {
+    /// A recording; repeat for several (shared physics, noise per recording).
+    #[arg(long, required = true)]
+    pub data: Vec<PathBuf>,
+    /// The nominal model (TOML, schema 1 or 2).
+    #[arg(long)]
+    pub model: PathBuf,
+    /// Degree K of the discrepancy that locates the mismatch (default 9).
+    #[arg(long)]
+    pub k: Option<usize>,
+    /// Candidate terms, comma separated (default: every term the model lacks).
+    #[arg(long, value_delimiter = ',')]
+    pub candidates: Option<Vec<String>>,
+    /// Write the report as JSON here.
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+    /// Write figures, fit.json and the amended model.toml here.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Rank and select only: no sampled fits before and after.
+    #[arg(long)]
+    pub rank_only: bool,
+    #[command(flatten)]
+    pub chains: ChainArgs,
+    #[arg(long, default_value_t = 500)]
+    pub warmup: usize,
+    #[arg(long, default_value_t = 500)]
+    pub draws: usize,
+}
+
+impl DiagnoseArgs {
+    /// The diagnosis these flags ask for: NUTS (dense), with the diagnosis's own metric
+    /// adaptation unless told.
+    pub fn options(&self) -> DiagnoseOptions {
+        DiagnoseOptions {
+            data: self.data.clone(),
+            model: self.model.clone(),
+            k: self.k,
+            candidates: self.candidates.clone(),
+            run: self.chains.run_adapting(
+                SamplerKind::NutsDense,
+                Some(self.warmup),
+                self.draws,
+                METRIC_ADAPTATION,
+            ),
+            out: self.out.clone(),
+            json: self.json.clone(),
+            rank_only: self.rank_only,
+        }
+    }
+}
+
+/// `motorcal diagnose`: the diagnosis, its report and the files it wrote.
+pub fn run(args: &DiagnoseArgs) -> Result<(), AppError> {
+    let diagnosis = diagnose(&args.options())?;
+    print!("{}", format_diagnosis(&diagnosis));
+    for path in &diagnosis.outputs {
+        println!("wrote {path}");
+    }
+    Ok(())
 }
 
 /// The whole command: read, discover, write; returns the report with the files it wrote.

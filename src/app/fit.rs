@@ -11,8 +11,11 @@ use crate::pipeline::{
     RunOutput, RunSettings, map_estimate, posterior_mean, run_sampler, write_draws,
 };
 
+use super::args::{ChainArgs, coefficient_prior};
 use super::figures::{plot_discrepancy, plot_predictive, plot_traces, write_predictive_csv};
 use super::{AppError, provenance};
+use crate::bayes::CoefficientFamily;
+use crate::pipeline::SamplerKind;
 use crate::study::{Problem, posterior_predictive};
 
 #[derive(Clone, Debug)]
@@ -29,6 +32,97 @@ pub struct FitOptions {
     /// `None`: the MAP and its Laplace approximation only.
     pub run: Option<RunSettings>,
     pub out: PathBuf,
+}
+
+#[derive(clap::Args, Clone, Debug)]
+pub struct FitArgs {
+    /// A recording (CSV with t, I, omega[, U]); repeat for several recordings, which share the
+    /// physics and have their own noise and discrepancy.
+    #[arg(long, required = true)]
+    pub data: Vec<PathBuf>,
+    /// The nominal model (TOML, schema 1 or 2).
+    #[arg(long)]
+    pub model: PathBuf,
+    /// Bayesian model: 1 (noise only) or 2 (noise + discrepancy); default: the model file's
+    /// [discrepancy], else 2.
+    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=2))]
+    pub bm: Option<u8>,
+    /// Degree K of the discrepancy (BM2); default: the model file's, else 9.
+    #[arg(long)]
+    pub k: Option<usize>,
+    /// Decay power p of the coefficient prior variance V0/(j+1)^p (0: the paper's prior).
+    #[arg(long, default_value_t = 0.0)]
+    pub prior_decay: f64,
+    /// Family of the coefficient prior.
+    #[arg(long, value_enum, default_value_t = CoefficientFamily::Laplace)]
+    pub prior_family: CoefficientFamily,
+    /// Only the MAP and its Laplace approximation, no sampling.
+    #[arg(long)]
+    pub map_only: bool,
+    #[command(flatten)]
+    pub run: RunArgs,
+    /// Output folder.
+    #[arg(long, default_value = "out/fit")]
+    pub out: PathBuf,
+}
+
+// Options of a command that runs one sampler.
+#[derive(clap::Args, Clone, Debug)]
+pub struct RunArgs {
+    #[arg(long, value_enum, default_value_t = SamplerKind::NutsDense)]
+    pub sampler: SamplerKind,
+    #[command(flatten)]
+    pub chains: ChainArgs,
+    /// Warm-up per chain (default: 100 for HMC/NUTS on the Laplace metric, else 1000).
+    #[arg(long)]
+    pub warmup: Option<usize>,
+    #[arg(long, default_value_t = 1000)]
+    pub draws: usize,
+    /// Keep only the last N draws of each chain.
+    #[arg(long)]
+    pub keep: Option<usize>,
+    /// Worker threads (default: all cores); draws do not depend on it.
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// HMC/NUTS: save the adapted step size and metric (TOML) for a later warm start.
+    #[arg(long)]
+    pub save_adaptation: Option<PathBuf>,
+    /// HMC/NUTS: start from a saved adaptation and skip adapting (use with a short --warmup).
+    #[arg(long)]
+    pub load_adaptation: Option<PathBuf>,
+}
+
+impl RunArgs {
+    pub fn settings(&self) -> RunSettings {
+        let mut run = self.chains.run(self.sampler, self.warmup, self.draws);
+        run.chain.keep = self.keep;
+        run.threads = self.threads;
+        run.save_adaptation = self.save_adaptation.clone();
+        run.load_adaptation = self.load_adaptation.clone();
+        run
+    }
+}
+
+impl FitArgs {
+    /// The fit these flags ask for.
+    pub fn options(&self) -> FitOptions {
+        FitOptions {
+            data: self.data.clone(),
+            model: self.model.clone(),
+            bm: self.bm,
+            k: self.k,
+            coefficient_prior: coefficient_prior(self.prior_family, self.prior_decay),
+            run: (!self.map_only).then(|| self.run.settings()),
+            out: self.out.clone(),
+        }
+    }
+}
+
+/// `motorcal fit`: the fit, then its report.
+pub fn run(args: &FitArgs) -> Result<(), AppError> {
+    let report = fit(&args.options())?;
+    print!("{}", format_report(&report));
+    Ok(())
 }
 
 /// The MAP with Laplace standard deviations, per unconstrained coordinate.

@@ -1,16 +1,20 @@
-//! The commands behind the binary: each turns options into library calls and reports. Kept in
-//! the library so that tests drive them exactly as a user does.
+//! The commands behind the binary: each declares its options (a clap `Args` struct), turns them
+//! into library calls, writes the files and prints (`<command>::run`). Kept in the library so
+//! that tests drive them exactly as a user does.
 
-// The command line's reading of the library's enums (clap's `ValueEnum`).
-mod args;
+// What the commands share: the chains' options, lists of degrees, and the command line's
+// reading of the library's enums (clap's `ValueEnum`).
+pub mod args;
 pub mod bench;
 pub mod cases;
 pub mod diagnose;
 pub mod figures;
 pub mod fit;
+pub mod merge;
 pub mod predict;
 /// The fit pipeline, where the commands have always found it.
 pub use crate::pipeline as run;
+pub mod select_k;
 pub mod simulate;
 pub mod summarize;
 pub mod sweep;

@@ -9,13 +9,28 @@ use crate::io::write_atomically;
 use super::AppError;
 use crate::study::{ChannelResidual, Problem, predict_records, residuals};
 
-#[derive(Clone, Debug)]
+// The command's options, as the command line and the tests give them.
+#[derive(clap::Args, Clone, Debug)]
 pub struct PredictOptions {
-    pub data: Vec<PathBuf>,
+    /// The model (e.g. the model.toml that `diagnose --out` writes).
+    #[arg(long)]
     pub model: PathBuf,
-    /// Per-sample CSV (t, measured, predicted, residual per channel), one file per record.
+    /// A recording; repeat for several.
+    #[arg(long, required = true)]
+    pub data: Vec<PathBuf>,
+    /// Write measured, predicted and residual per sample as CSV.
+    #[arg(long)]
     pub csv: Option<PathBuf>,
+    /// Write the residual table as JSON.
+    #[arg(long)]
     pub json: Option<PathBuf>,
+}
+
+/// `motorcal predict`: the residual table.
+pub fn run(options: &PredictOptions) -> Result<(), AppError> {
+    let table = predict(options)?;
+    print!("{}", format_residuals(&table));
+    Ok(())
 }
 
 /// The whole command: read, simulate, report; writes nothing if anything fails before.

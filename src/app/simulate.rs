@@ -21,20 +21,40 @@ use crate::synthetic::{DEFAULT_SEED, generate, sample_times};
 
 use super::AppError;
 
-/// Options of `motorcal simulate`.
-#[derive(Clone, Debug)]
+// The options of `motorcal simulate`, as the command line and the tests give them.
+#[derive(clap::Args, Clone, Debug)]
 pub struct SimulateOptions {
-    /// The motor that makes the data; the paper's (φ = 1) when absent.
+    /// Model file of the motor that makes the data (default: the paper's, c_g = 0.01).
+    #[arg(long)]
     pub truth: Option<PathBuf>,
-    /// The model the user believes; when absent, the paper's simulation model (c_g = 0.009) for
-    /// the paper's truth, or the truth itself.
+    /// Model file the user believes (default: the paper's c_g = 0.009, or the truth).
+    #[arg(long)]
     pub nominal: Option<PathBuf>,
+    /// Output folder for recording.csv, motor.toml and truth.toml.
+    #[arg(long, default_value = "simulated")]
     pub out: PathBuf,
+    #[arg(long, default_value_t = DEFAULT_SEED)]
     pub seed: u64,
+    #[arg(long, value_enum, default_value_t = InputProfile::Constant)]
     pub input: InputProfile,
-    pub noise_sd: [f64; 2],
+    /// Noise standard deviations of I [A] and ω [rad/s].
+    #[arg(long, num_args = 2, value_names = ["SD_I", "SD_OMEGA"], default_values_t = [2.0, 10.0])]
+    pub noise_sd: Vec<f64>,
+    #[arg(long, default_value_t = 501)]
     pub samples: usize,
+    /// Length of the record [s].
+    #[arg(long, default_value_t = 0.5)]
     pub t_end: f64,
+    /// A concealed-physics case instead: the hidden effect(s) (a term name, two comma
+    /// separated, or `none`); writes recording.csv, motor.toml and answer.json.
+    #[arg(long, value_delimiter = ',', conflicts_with_all = ["truth", "nominal"])]
+    pub effect: Option<Vec<String>>,
+    /// With --effect: the peak effect over the noise σ (default: drawn in 0.6..1.5).
+    #[arg(long, requires = "effect", allow_negative_numbers = true)]
+    pub magnitude: Option<f64>,
+    /// With --effect: keep the effect below 1.5σ and redraw until it is identifiable.
+    #[arg(long, requires = "effect")]
+    pub conceal: bool,
 }
 
 impl Default for SimulateOptions {
@@ -45,11 +65,61 @@ impl Default for SimulateOptions {
             out: PathBuf::from("simulated"),
             seed: DEFAULT_SEED,
             input: InputProfile::Constant,
-            noise_sd: [2.0, 10.0],
+            noise_sd: vec![2.0, 10.0],
             samples: 501,
             t_end: 0.5,
+            effect: None,
+            magnitude: None,
+            conceal: false,
         }
     }
+}
+
+/// `motorcal simulate`: a recording with its nominal model and truth, or with `--effect` a
+/// concealed-physics case; says what it wrote.
+pub fn run(options: &SimulateOptions) -> Result<(), AppError> {
+    let out = &options.out;
+    if let Some(effects) = &options.effect {
+        let answer = super::cases::write_case(
+            &crate::study::cases::CaseOptions {
+                effects: effects.clone(),
+                magnitude: options.magnitude,
+                input: options.input,
+                seed: options.seed,
+                conceal: options.conceal,
+            },
+            out,
+        )?;
+        println!(
+            "wrote {} (effect {}, peak {:.2}/{:.2} σ on I/ω, input {:?}{})",
+            out.display(),
+            answer.effect,
+            answer.max_abs_effect_over_sigma["I"],
+            answer.max_abs_effect_over_sigma["omega"],
+            answer.input,
+            if answer.input_fallback {
+                ", after falling back"
+            } else {
+                ""
+            }
+        );
+        return Ok(());
+    }
+    let report = simulate(options)?;
+    println!("wrote {}", report.recording.display());
+    println!(
+        "wrote {} (the model a user would believe)",
+        report.nominal.display()
+    );
+    println!(
+        "wrote {} (the truth that made the data)",
+        report.truth.display()
+    );
+    println!(
+        "realised noise sd: I {:.4} A, omega {:.4} rad/s (seed {})",
+        report.realised_noise_sd[0], report.realised_noise_sd[1], options.seed
+    );
+    Ok(())
 }
 
 /// What `simulate` wrote.
@@ -74,10 +144,11 @@ pub fn simulate(options: &SimulateOptions) -> Result<SimulateReport, AppError> {
             options.t_end
         )));
     }
-    if options
-        .noise_sd
-        .iter()
-        .any(|s| !(*s >= 0.0 && s.is_finite()))
+    if options.noise_sd.len() != 2
+        || options
+            .noise_sd
+            .iter()
+            .any(|s| !(*s >= 0.0 && s.is_finite()))
     {
         return Err(AppError::Usage(format!(
             "--noise-sd {:?} : must be non-negative numbers",

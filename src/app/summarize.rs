@@ -7,6 +7,29 @@ use crate::io::read_draws;
 
 use super::AppError;
 
+#[derive(clap::Args, Clone, Debug)]
+pub struct SummarizeArgs {
+    #[arg(required = true)]
+    pub draws: Vec<PathBuf>,
+    /// Also write the summary as JSON.
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+}
+
+/// `motorcal summarize`: the table, and the JSON if asked.
+pub fn run(args: &SummarizeArgs) -> Result<(), AppError> {
+    let (summaries, chains, n) = summarize_files(&args.draws)?;
+    println!("{chains} chains × {n} draws");
+    print!("{}", format_table(&summaries));
+    if let Some(path) = &args.json {
+        let text = serde_json::to_string_pretty(&summaries)
+            .map_err(|e| AppError::Output(e.to_string()))?;
+        crate::io::write_atomically(path, text.as_bytes())?;
+        println!("wrote {}", path.display());
+    }
+    Ok(())
+}
+
 /// Summaries of every parameter in the draws files (ours or the peers' long layout).
 pub fn summarize_files(
     paths: &[PathBuf],

@@ -3,14 +3,144 @@
 
 use std::path::PathBuf;
 
-use crate::pipeline::{RunCost, RunOutput};
+use crate::bayes::CoefficientFamily;
+use crate::pipeline::{RunCost, RunOutput, SamplerKind};
 use crate::plot::{self, KSeries};
 use crate::study::Reference;
 
 use super::AppError;
+use super::args::{ChainArgs, coefficient_prior, parse_ks};
 use super::figures::plot_discrepancy;
 
 pub use crate::paper::sweep::*;
+
+// The options of `motorcal sweep` and `motorcal select-k`.
+#[derive(clap::Args, Clone, Debug)]
+pub struct SweepArgs {
+    /// Degrees: a range (0..=20) or a comma list (default 0..=20).
+    #[arg(long, default_value = "0..=20")]
+    pub k: String,
+    /// Seeds of the synthetic noise, apart from the chains' --seed: one, a list or a range
+    /// (default: the paper's data, 20180823). The grid is every (seed, K).
+    #[arg(long, default_value = "20180823")]
+    pub data_seed: String,
+    /// Run one slice of the grid: grid points whose index is i − 1 modulo n (`--shard 3/8`);
+    /// `motorcal merge` joins the slices' JSON into what one run writes.
+    #[arg(long)]
+    pub shard: Option<String>,
+    /// Decay power p of the coefficient prior variance V0/(j+1)^p (0: the paper's prior).
+    #[arg(long, default_value_t = 0.0)]
+    pub prior_decay: f64,
+    #[arg(long, value_enum, default_value_t = CoefficientFamily::Laplace)]
+    pub prior_family: CoefficientFamily,
+    #[arg(long, value_enum, default_value_t = SamplerKind::NutsDense)]
+    pub sampler: SamplerKind,
+    #[command(flatten)]
+    pub chains: ChainArgs,
+    /// Warm-up per chain (default: 100 for HMC/NUTS on the Laplace metric, which keeps R-hat
+    /// and ESS at every K; else 1000; papers/john2018, "The warm-up").
+    #[arg(long)]
+    pub warmup: Option<usize>,
+    #[arg(long, default_value_t = 1000)]
+    pub draws: usize,
+    #[arg(long, default_value = "out/sweep")]
+    pub out: PathBuf,
+    /// Write the records (or, for select-k, the choice) as JSON here.
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+    /// Degrees at which to draw δ's band against d0 and the coefficients' marginals (a list).
+    #[arg(long)]
+    pub figures_at: Option<String>,
+    /// select-k: `sigma-stabilisation` (§3.2.3) or `evidence` (the largest log marginal
+    /// likelihood, by importance sampling).
+    // Read as text and turned into the `ValueEnum` by `SweepArgs::rule`, so that a rule
+    // mistyped stays one line naming `--rule` (tests/cli.rs), and `--help` as it was.
+    #[arg(long, default_value = "sigma-stabilisation")]
+    pub rule: String,
+}
+
+impl SweepArgs {
+    /// The rule of `--rule`.
+    pub fn rule(&self) -> Result<select::Rule, AppError> {
+        <select::Rule as clap::ValueEnum>::from_str(&self.rule, false).map_err(|_| {
+            AppError::Usage(format!(
+                "--rule {}: known rules are sigma-stabilisation and evidence",
+                self.rule
+            ))
+        })
+    }
+
+    /// The sweep these flags ask for (`--json` is the records' unless `select`: then the
+    /// choice's).
+    pub fn options(&self, select: bool) -> Result<SweepOptions, AppError> {
+        let ks = parse_ks(&self.k).map_err(|e| AppError::Usage(format!("--k {e}")))?;
+        self.rule()?;
+        Ok(SweepOptions {
+            ks,
+            coefficient_prior: coefficient_prior(self.prior_family, self.prior_decay),
+            data_seeds: parse_ks(&self.data_seed)
+                .map_err(|e| AppError::Usage(format!("--data-seed {e}")))?
+                .into_iter()
+                .map(|s| s as u64)
+                .collect(),
+            shard: match &self.shard {
+                None => None,
+                Some(text) => Some(parse_shard(text)?),
+            },
+            run: self.chains.run(self.sampler, self.warmup, self.draws),
+            out: self.out.clone(),
+            json: if select { None } else { self.json.clone() },
+            figures_at: match &self.figures_at {
+                None => Vec::new(),
+                Some(text) => {
+                    parse_ks(text).map_err(|e| AppError::Usage(format!("--figures-at {e}")))?
+                }
+            },
+        })
+    }
+}
+
+fn parse_shard(text: &str) -> Result<(usize, usize), AppError> {
+    let bad = || {
+        AppError::Usage(format!(
+            "--shard {text}: write i/n with 1 ≤ i ≤ n, e.g. 3/8"
+        ))
+    };
+    let (i, n) = text.split_once('/').ok_or_else(bad)?;
+    let (i, n): (usize, usize) = (
+        i.trim().parse().map_err(|_| bad())?,
+        n.trim().parse().map_err(|_| bad())?,
+    );
+    if !(n >= 1 && (1..=n).contains(&i)) {
+        return Err(bad());
+    }
+    Ok((i, n))
+}
+
+/// `motorcal sweep`: the sweep, its table and the files it wrote.
+pub fn run(args: &SweepArgs) -> Result<(), AppError> {
+    let options = args.options(false)?;
+    run_options(&options).map(|_| ())
+}
+
+/// The sweep of `options`, printed and written; its records.
+pub(super) fn run_options(options: &SweepOptions) -> Result<Vec<SweepRecord>, AppError> {
+    let records = sweep(options)?;
+    print_and_write(&records, options)?;
+    Ok(records)
+}
+
+/// The table, then the files.
+pub(super) fn print_and_write(
+    records: &[SweepRecord],
+    options: &SweepOptions,
+) -> Result<(), AppError> {
+    print!("{}", format_table(records));
+    for path in write_outputs(records, options)? {
+        println!("wrote {}", path.display());
+    }
+    Ok(())
+}
 
 /// The sweep with the figures at `figures_at` drawn as each K finishes.
 pub fn sweep(options: &SweepOptions) -> Result<Vec<SweepRecord>, AppError> {

@@ -1,16 +1,79 @@
 //! `motorcal reproduce table1`: the paper's Table 1 (`paper::table1`), its draws, figures,
 //! JSON, CSV and the human table.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use crate::io::provenance;
-use crate::pipeline::write_draws;
+use crate::pipeline::{SamplerKind, write_draws};
 use crate::study::posterior_predictive;
 
 use super::AppError;
+use super::args::ChainArgs;
 use super::figures::{plot_discrepancy, plot_predictive, plot_traces};
 
 pub use crate::paper::table1::*;
+
+#[derive(clap::Args, Clone, Debug)]
+pub struct Table1Args {
+    /// BM2 runs of 10000 instead of 100000 draws.
+    #[arg(long)]
+    pub quick: bool,
+    /// Samplers to run, comma separated.
+    #[arg(long, value_enum, value_delimiter = ',', default_values_t = [SamplerKind::Metropolis, SamplerKind::AdaptiveMetropolis, SamplerKind::NutsDense])]
+    pub samplers: Vec<SamplerKind>,
+    #[command(flatten)]
+    pub chains: ChainArgs,
+    /// Worker threads (default: all cores); draws do not depend on it.
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Output folder for draws, table1.json and table1.csv.
+    #[arg(long, default_value = "out/table1")]
+    pub out: PathBuf,
+}
+
+impl Table1Args {
+    /// The reproduction these flags ask for; what is not given is the paper's protocol.
+    pub fn options(&self) -> Table1Options {
+        let defaults = Table1Options::default();
+        Table1Options {
+            seed: self.chains.seed,
+            quick: self.quick,
+            samplers: self.samplers.clone(),
+            chains: self.chains.chains_or(defaults.chains),
+            threads: self.threads,
+            out: self.out.clone(),
+            quiet: self.chains.quiet,
+            metric_adaptation: self
+                .chains
+                .metric_adaptation
+                .unwrap_or(defaults.metric_adaptation),
+        }
+    }
+}
+
+/// `motorcal reproduce table1`: the table, and what it wrote.
+pub fn run(args: &Table1Args) -> Result<(), AppError> {
+    run_options(&args.options())
+}
+
+/// `motorcal` without a command: Table 1 by the paper's protocol.
+pub fn run_default() -> Result<(), AppError> {
+    println!(
+        "motorcal: reproducing the paper's Table 1 (see `motorcal --help` for the other commands)\n"
+    );
+    run_options(&Table1Options::default())
+}
+
+fn run_options(options: &Table1Options) -> Result<(), AppError> {
+    let report = table1(options)?;
+    print!("{}", format_report(&report));
+    println!();
+    println!(
+        "wrote {}/table1.json, table1.csv, figures and the draws (CmdStan CSV)",
+        options.out.display()
+    );
+    Ok(())
+}
 
 /// The whole command: runs, then the draws and figures of each as it finishes, then the report.
 pub fn table1(options: &Table1Options) -> Result<Table1Report, AppError> {

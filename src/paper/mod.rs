@@ -2,5 +2,6 @@
 //! error measures and the choice of K (`sweep`), and the samplers' ESS per second across K
 //! (`bench`).
 
+pub mod bench;
 pub mod sweep;
 pub mod table1;

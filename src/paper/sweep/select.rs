@@ -16,6 +16,36 @@ use serde::Serialize;
 use super::SweepRecord;
 
 pub const TOLERANCE: f64 = 0.5;
+
+/// The rules that choose K: §3.2.3's σ-stabilisation ([`sigma_stabilisation`]) or the largest
+/// log evidence ([`evidence`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Rule {
+    #[default]
+    SigmaStabilisation,
+    Evidence,
+}
+
+impl Rule {
+    pub const ALL: [Rule; 2] = [Rule::SigmaStabilisation, Rule::Evidence];
+
+    /// The rule's name, as the selections record it (`rule`).
+    pub fn name(&self) -> &'static str {
+        match self {
+            Rule::SigmaStabilisation => "sigma-stabilisation",
+            Rule::Evidence => "evidence",
+        }
+    }
+}
+
+/// A rule by its [`Rule::name`].
+impl std::str::FromStr for Rule {
+    type Err = crate::error::Error;
+
+    fn from_str(text: &str) -> Result<Self, Self::Err> {
+        crate::error::parse_name("rule", text, &Self::ALL, Self::name)
+    }
+}
 /// L = 1, 2, 3, as §3.2.3 asks.
 pub const LOOK_AHEAD: usize = 3;
 
@@ -91,7 +121,7 @@ pub fn sigma_stabilisation(records: &[SweepRecord]) -> Selection {
             .iter()
             .find(|d| d.distance < TOLERANCE)
             .map(|d| d.k),
-        rule: "sigma-stabilisation".into(),
+        rule: Rule::SigmaStabilisation.name().into(),
         tolerance: TOLERANCE,
         distances,
     }
@@ -140,7 +170,7 @@ pub fn evidence(records: &[SweepRecord]) -> EvidenceSelection {
         .map(|e| e.k);
     EvidenceSelection {
         k,
-        rule: "evidence".into(),
+        rule: Rule::Evidence.name().into(),
         evidences,
     }
 }
