@@ -4,15 +4,15 @@
 
 use std::path::{Path, PathBuf};
 
-use motorcal::app::fit::{FitOptions, FitReport, fit};
-use motorcal::bayes::{CalibratedParameter, CoefficientPrior, PriorInU};
+use motorcal::bayes::{CalibratedParameter, PriorInU};
 use motorcal::density::{DensityError, FisherMetric, LogDensity, StartingPoint};
 use motorcal::diagnostics::ParameterSummary;
 use motorcal::io::{Recording, write_recording};
 use motorcal::motor::{ActiveTerm, MotorModel, MotorParameters, Term, VoltageInput};
 use motorcal::parameter::{ParamId, ParameterSpec, Prior, Support};
-use motorcal::pipeline::{RunSettings, SamplerKind, run_sampler};
+use motorcal::pipeline::{RunOutput, RunSettings, SamplerKind, map_estimate, run_sampler};
 use motorcal::sampler::ChainSettings;
+use motorcal::study::Problem;
 use motorcal::synthetic::{generate, sample_times};
 use nalgebra::DMatrix;
 
@@ -126,21 +126,23 @@ fn nuts(seed: u64) -> RunSettings {
     }
 }
 
-fn fit_bm1(dir: &Path, data: &[&str], model_text: &str, seed: u64) -> FitReport {
+/// The model file and recordings as `motorcal fit --bm 1` reads them.
+fn problem(dir: &Path, data: &[&str], model_text: &str) -> Problem {
     std::fs::write(dir.join("model.toml"), model_text).unwrap();
-    fit(&FitOptions {
-        data: data.iter().map(|f| dir.join(f)).collect(),
-        model: dir.join("model.toml"),
-        bm: Some(1),
-        k: None,
-        coefficient_prior: CoefficientPrior::default(),
-        run: Some(nuts(seed)),
-        out: dir.to_path_buf(),
-    })
-    .unwrap()
+    let data: Vec<PathBuf> = data.iter().map(|f| dir.join(f)).collect();
+    Problem::from_files(&data, &dir.join("model.toml")).unwrap()
 }
 
-fn summary<'a>(report: &'a FitReport, name: &str) -> &'a ParameterSummary {
+/// BM1 sampled by NUTS, as `motorcal fit --bm 1` runs it.
+fn fit_bm1(dir: &Path, data: &[&str], model_text: &str, seed: u64) -> RunOutput {
+    let problem = problem(dir, data, model_text);
+    let mut posterior = problem
+        .posterior(&problem.model_settings(Some(1), None))
+        .unwrap();
+    run_sampler(&mut posterior, &nuts(seed), "BM1").unwrap()
+}
+
+fn summary<'a>(report: &'a RunOutput, name: &str) -> &'a ParameterSummary {
     report
         .summaries
         .iter()
@@ -172,11 +174,7 @@ fn every_term_is_recovered_from_a_recording_where_it_is_clearly_visible() {
             text.push_str(&format!("\"{name}.{}\" = {{}}\n", p.key));
         }
         let report = fit_bm1(&dir, &["recording.csv"], &text, 7);
-        assert!(
-            report.max_rhat.unwrap() <= 1.01,
-            "{name}: R-hat {}",
-            report.max_rhat.unwrap()
-        );
+        assert!(report.max_rhat <= 1.01, "{name}: R-hat {}", report.max_rhat);
         let r = summary(&report, "R");
         assert!((r.mean - 0.1).abs() <= 3.0 * r.sd, "{name}: R {r:?}");
         for (p, t) in term.params().iter().zip(&truth) {
@@ -190,7 +188,7 @@ fn every_term_is_recovered_from_a_recording_where_it_is_clearly_visible() {
                 (s.mean - t) / s.sd,
                 r.mean,
                 r.sd,
-                report.max_rhat.unwrap()
+                report.max_rhat
             );
             assert!(
                 (s.mean - t).abs() <= 3.0 * s.sd,
@@ -220,7 +218,7 @@ fn a_parameter_whose_nominal_value_is_zero_calibrates() {
     let text = "schema = 2\n[motor]\nT_L = 0.0\n[calibrate]\nR = {}\n\"load_torque.T_0\" = {}\n";
     let report = fit_bm1(&dir, &["recording.csv"], text, 3);
     let t0 = summary(&report, "load_torque__T_0");
-    assert!(report.max_rhat.unwrap() <= 1.01);
+    assert!(report.max_rhat <= 1.01);
     assert!((t0.mean - 0.05).abs() <= 3.0 * t0.sd, "{t0:?}");
 }
 
@@ -237,14 +235,14 @@ fn two_recordings_with_different_inputs_pin_a_shared_parameter_better_than_eithe
     record(&dir, "constant.csv", coulomb(), VoltageInput::Constant, 21);
     record(&dir, "reversal.csv", coulomb(), reversal(&times), 22);
     let text = "schema = 2\n[calibrate]\nR = {}\n\"coulomb_friction.T_c\" = {}\n";
-    let width = |report: &FitReport| {
+    let width = |report: &RunOutput| {
         let s = summary(report, "coulomb_friction__T_c");
         s.q975 - s.q025
     };
     let alone_constant = fit_bm1(&dir, &["constant.csv"], text, 1);
     let alone_reversal = fit_bm1(&dir, &["reversal.csv"], text, 1);
     let together = fit_bm1(&dir, &["constant.csv", "reversal.csv"], text, 1);
-    assert!(together.max_rhat.unwrap() <= 1.01);
+    assert!(together.max_rhat <= 1.01);
     let (a, b, both) = (
         width(&alone_constant),
         width(&alone_reversal),
@@ -393,30 +391,26 @@ fn all_terms_at_once_simulate_and_find_a_map() {
             text.push_str(&format!("\"{name}.{}\" = {{}}\n", p.key));
         }
     }
-    std::fs::write(dir.join("model.toml"), &text).unwrap();
-    let report = fit(&FitOptions {
-        data: vec![dir.join("recording.csv")],
-        model: dir.join("model.toml"),
-        bm: Some(1),
-        k: None,
-        coefficient_prior: CoefficientPrior::default(),
-        run: None,
-        out: dir.clone(),
-    })
-    .unwrap();
+    let problem = problem(&dir, &["recording.csv"], &text);
+    let mut posterior = problem
+        .posterior(&problem.model_settings(Some(1), None))
+        .unwrap();
+    let map = map_estimate(&mut posterior).unwrap();
     // R and every term's parameters (load_step has two).
     let expected = 1 + Term::NAMES
         .iter()
         .map(|n| Term::named(n).unwrap().params().len())
         .sum::<usize>();
-    assert_eq!(report.calibrated.len(), expected);
-    assert!(report.map_log_likelihood.is_finite() && report.log_evidence_laplace.is_finite());
+    assert_eq!(posterior.calibrated().len(), expected);
+    assert!(posterior.log_likelihood(&map.x).unwrap().is_finite());
+    assert!(map.log_evidence_laplace.is_finite());
     // Several terms are nearly degenerate together, so no recovery is claimed, and the MAP
     // search in 17 dimensions along near-degenerate directions stops short of the noise level
     // (it only has to come close to it).
-    for f in &report.fit {
-        let noise = if f.channel == "I" { NOISE[0] } else { NOISE[1] };
-        assert!(f.rmse < 1.5 * noise, "{f:?}");
+    let residuals = posterior.residuals(&map.x, 0).unwrap();
+    for (c, res) in residuals.iter().enumerate() {
+        let rmse = (res.iter().map(|v| v * v).sum::<f64>() / res.len() as f64).sqrt();
+        assert!(rmse < 1.5 * NOISE[c], "channel {c}: RMSE {rmse}");
     }
 }
 
