@@ -1,10 +1,12 @@
 //! The problem a user poses: recordings plus the model they believe (from files, from memory
 //! or from the paper's synthetic set-up) → the posterior of BM1/BM2 with the noise-prior policy
 //! of its base; what a fitted model predicts; the inputs of synthetic experiments; and the
-//! concealed-physics cases made to test the discovery.
+//! concealed-physics cases made to test the discovery; and the check that a recording can be
+//! this motor at all (`plausibility`).
 
 pub mod cases;
 mod inputs;
+pub mod plausibility;
 mod predict;
 pub mod predictive;
 mod problem;

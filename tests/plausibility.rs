@@ -1,0 +1,187 @@
+//! Recordings that cannot be this motor are named as such, with the likely mistake, before any
+//! physics is asked of them; recordings that can be pass untouched.
+
+use std::path::Path;
+
+use motorcal::io::Recording;
+use motorcal::study::Problem;
+use motorcal::study::plausibility::{Finding, check};
+
+fn paper() -> Problem {
+    Problem::paper(motorcal::synthetic::DEFAULT_SEED).unwrap()
+}
+
+/// The paper's recording with `alter` applied to it.
+fn altered(mut alter: impl FnMut(&mut Recording)) -> Problem {
+    let mut problem = paper();
+    alter(&mut problem.recordings[0]);
+    problem
+}
+
+fn channel<'a>(r: &'a mut Recording, name: &str) -> &'a mut Vec<f64> {
+    &mut r.channels.iter_mut().find(|(n, _)| n == name).unwrap().1
+}
+
+fn findings(problem: &Problem) -> Vec<Finding> {
+    let started = std::time::Instant::now();
+    let found = check(problem).unwrap();
+    for f in &found {
+        eprintln!("{f}");
+    }
+    eprintln!("checked in {:.3} s", started.elapsed().as_secs_f64());
+    found
+}
+
+fn assert_named(found: &[Finding], channel: &str, cause: &str) {
+    assert!(
+        found.iter().any(|f| f.channel == channel
+            && (f.likely_cause.contains(cause) || f.finding.contains(cause))),
+        "expected {channel}: …{cause}…, found {found:#?}"
+    );
+}
+
+#[test]
+fn the_papers_recording_is_plausible() {
+    assert!(findings(&paper()).is_empty());
+}
+
+#[test]
+fn all_channels_zero_is_a_dead_recording() {
+    let found = findings(&altered(|r| {
+        for (_, v) in r.channels.iter_mut() {
+            v.iter_mut().for_each(|x| *x = 0.0);
+        }
+    }));
+    assert_named(&found, "I", "was the drive running");
+    assert_named(&found, "omega", "was the drive running");
+    assert!(
+        found
+            .iter()
+            .any(|f| f.finding.contains("omega is 0 throughout"))
+    );
+}
+
+#[test]
+fn a_constant_speed_channel_is_named() {
+    let found = findings(&altered(|r| {
+        channel(r, "omega").iter_mut().for_each(|x| *x = 1234.5)
+    }));
+    assert_named(&found, "omega", "was the drive running");
+    assert!(found.iter().all(|f| f.channel != "I"), "{found:#?}");
+}
+
+#[test]
+fn swapped_current_and_speed_are_named() {
+    let found = findings(&altered(|r| {
+        let i = channel(r, "I").clone();
+        let w = channel(r, "omega").clone();
+        *channel(r, "I") = w;
+        *channel(r, "omega") = i;
+    }));
+    assert_named(&found, "I/omega", "swapped");
+}
+
+#[test]
+fn the_current_in_a_wrong_unit_is_named() {
+    let scaled =
+        |factor: f64| altered(move |r| channel(r, "I").iter_mut().for_each(|x| *x *= factor));
+    assert_named(&findings(&scaled(1e3)), "I", "mA");
+    assert_named(&findings(&scaled(1e12)), "I", "does not follow");
+}
+
+#[test]
+fn the_speed_in_rpm_is_named() {
+    let found = findings(&altered(|r| {
+        let f = 60.0 / (2.0 * std::f64::consts::PI);
+        channel(r, "omega").iter_mut().for_each(|x| *x *= f)
+    }));
+    assert_named(&found, "omega", "rpm");
+}
+
+#[test]
+fn a_sign_flipped_current_is_named() {
+    let found = findings(&altered(|r| {
+        channel(r, "I").iter_mut().for_each(|x| *x = -*x)
+    }));
+    assert_named(&found, "I", "wrong sign");
+}
+
+#[test]
+fn time_in_milliseconds_is_named() {
+    let found = findings(&altered(|r| r.time.iter_mut().for_each(|t| *t *= 1e3)));
+    assert_named(&found, "t", "ms");
+}
+
+#[test]
+fn a_recording_of_pure_noise_is_named() {
+    use rand::SeedableRng;
+    use rand_distr::{Distribution, Normal};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+    let found = findings(&altered(|r| {
+        for (_, v) in r.channels.iter_mut() {
+            v.iter_mut()
+                .for_each(|x| *x = Normal::new(0.0, 5.0).unwrap().sample(&mut rng));
+        }
+    }));
+    assert_named(&found, "I", "does not follow");
+    assert_named(&found, "omega", "does not follow");
+}
+
+/// The development set's fourteen cases pass untouched (skipped without ../shared).
+#[test]
+fn the_development_set_is_plausible() {
+    let dev = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/concealed-dev");
+    if !dev.is_dir() {
+        eprintln!("skipped: {} is absent", dev.display());
+        return;
+    }
+    for i in 1..=14 {
+        let dir = dev.join(format!("case{i:02}"));
+        let problem =
+            Problem::from_files(&[dir.join("recording.csv")], &dir.join("motor.toml")).unwrap();
+        assert!(findings(&problem).is_empty(), "case{i:02}");
+    }
+}
+
+/// The crate's own concealed cases pass untouched (no ../shared needed).
+#[test]
+fn the_fixture_cases_are_plausible() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/cases");
+    for case in ["coulomb_friction", "torque_constant"] {
+        let dir = root.join(case);
+        let problem =
+            Problem::from_files(&[dir.join("recording.csv")], &dir.join("motor.toml")).unwrap();
+        assert!(findings(&problem).is_empty(), "{case}");
+    }
+}
+
+/// The real EMPS and HSM150 records with the examples' drive models pass untouched (skipped
+/// without ../shared).
+#[test]
+fn the_real_records_are_plausible() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let real = root.join("../shared/data/real");
+    if !real.is_dir() {
+        eprintln!("skipped: {} is absent", real.display());
+        return;
+    }
+    let emps = Problem::from_files(
+        &[real.join("emps/emps_estimation.csv")],
+        &root.join("examples/emps/model.toml"),
+    )
+    .unwrap();
+    assert!(findings(&emps).is_empty(), "EMPS");
+    for name in [
+        "idf_pos_0.06_1",
+        "idf_neg_0.04_1",
+        "idf_pos_0.06_2",
+        "idf_neg_0.04_3",
+    ] {
+        let hsm = Problem::from_files(
+            &[real.join(format!("hsm150/{name}.csv"))],
+            &root.join("examples/hsm150/model.toml"),
+        )
+        .unwrap();
+        assert!(findings(&hsm).is_empty(), "HSM150 {name}");
+    }
+}
