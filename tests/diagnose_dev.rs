@@ -42,6 +42,7 @@ fn run(case: &Path, rank_only: bool) -> Diagnosis {
             ..RunSettings::default()
         },
         rank_only,
+        implausible: Vec::new(),
     };
     discover(&problem, &settings).expect("diagnose runs")
 }

@@ -63,6 +63,7 @@ fn diagnose_load_step_at(t_s: f64, noise_sd: [f64; 2], name: &str) -> Diagnosis 
                 ..RunSettings::default()
             },
             rank_only: true,
+            implausible: Vec::new(),
         },
     )
     .unwrap();

@@ -185,3 +185,58 @@ fn the_real_records_are_plausible() {
         assert!(findings(&hsm).is_empty(), "HSM150 {name}");
     }
 }
+
+/// The commands refuse such a recording with one line per finding and write nothing; with
+/// `--force` diagnose goes on, reports the findings and selects no physics.
+#[test]
+fn diagnose_refuses_a_dead_recording_unless_forced() {
+    let dir = std::env::temp_dir().join(format!("motorcal-plaus-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let case = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/cases/torque_constant");
+    let text = std::fs::read_to_string(case.join("recording.csv")).unwrap();
+    let mut zeroed = String::new();
+    for (i, line) in text.lines().enumerate() {
+        if i == 0 || line.starts_with('#') {
+            zeroed.push_str(line);
+        } else {
+            let t = line.split(',').next().unwrap();
+            zeroed.push_str(&format!("{t},0,0"));
+        }
+        zeroed.push('\n');
+    }
+    assert!(text.lines().next().unwrap().starts_with("t,I,omega"));
+    let data = dir.join("zeros.csv");
+    std::fs::write(&data, zeroed).unwrap();
+    let json = dir.join("report.json");
+    let run = |extra: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_motorcal"))
+            .args(["diagnose", "--quiet", "--rank-only", "--data"])
+            .arg(&data)
+            .arg("--model")
+            .arg(case.join("motor.toml"))
+            .arg("--json")
+            .arg(&json)
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let refused = run(&[]);
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert!(!refused.status.success());
+    assert!(
+        stderr.contains("zeros.csv") && stderr.contains("omega is 0 throughout"),
+        "{stderr}"
+    );
+    assert!(!json.exists(), "nothing written");
+    let forced = run(&["--force"]);
+    assert!(
+        forced.status.success(),
+        "{}",
+        String::from_utf8_lossy(&forced.stderr)
+    );
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(report["selected"], "none");
+    assert!(!report["implausible"].as_array().unwrap().is_empty());
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -83,6 +83,7 @@ fn diagnose(o: &DiagnoseOptions) -> Result<Diagnosis, Error> {
             candidates: o.candidates.clone(),
             run: o.run.clone(),
             rank_only: o.rank_only,
+            implausible: Vec::new(),
         },
     )
 }

@@ -31,6 +31,9 @@ pub struct DiagnoseOptions {
     pub json: Option<PathBuf>,
     /// Skip the sampled fits (ranking, selection and ties only).
     pub rank_only: bool,
+    /// Go on when the recordings cannot be this motor (the report carries the findings and
+    /// selects nothing).
+    pub force: bool,
 }
 
 #[derive(clap::Args, Clone, Debug)]
@@ -56,6 +59,10 @@ pub struct DiagnoseArgs {
     /// Rank and select only: no sampled fits before and after.
     #[arg(long)]
     pub rank_only: bool,
+    /// Go on when a recording cannot be this motor as set up (a dead channel, a unit, sign or
+    /// swap, time in ms): the report lists the findings and selects no physics.
+    #[arg(long)]
+    pub force: bool,
     #[command(flatten)]
     pub chains: ChainArgs,
     #[arg(long, default_value_t = 500)]
@@ -82,6 +89,7 @@ impl DiagnoseArgs {
             out: self.out.clone(),
             json: self.json.clone(),
             rank_only: self.rank_only,
+            force: self.force,
         }
     }
 }
@@ -100,11 +108,13 @@ pub fn run(args: &DiagnoseArgs) -> Result<(), AppError> {
 pub fn diagnose(options: &DiagnoseOptions) -> Result<Diagnosis, AppError> {
     let started = std::time::Instant::now();
     let problem = Problem::from_files(&options.data, &options.model)?;
+    let implausible = super::plausible(&problem, options.force)?;
     let settings = DiscoverSettings {
         k: options.k,
         candidates: options.candidates.clone(),
         run: options.run.clone(),
         rank_only: options.rank_only,
+        implausible,
     };
     let mut diagnosis = discover(&problem, &settings)?;
     if let Some(out) = &options.out {

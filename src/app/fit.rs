@@ -32,6 +32,8 @@ pub struct FitOptions {
     /// `None`: the MAP and its Laplace approximation only.
     pub run: Option<RunSettings>,
     pub out: PathBuf,
+    /// Go on when a recording cannot be this motor as set up.
+    pub force: bool,
 }
 
 #[derive(clap::Args, Clone, Debug)]
@@ -59,6 +61,10 @@ pub struct FitArgs {
     /// Only the MAP and its Laplace approximation, no sampling.
     #[arg(long)]
     pub map_only: bool,
+    /// Go on when a recording cannot be this motor as set up (a dead channel, a unit, sign or
+    /// swap, time in ms).
+    #[arg(long)]
+    pub force: bool,
     #[command(flatten)]
     pub run: RunArgs,
     /// Output folder.
@@ -114,6 +120,7 @@ impl FitArgs {
             coefficient_prior: coefficient_prior(self.prior_family, self.prior_decay),
             run: (!self.map_only).then(|| self.run.settings()),
             out: self.out.clone(),
+            force: self.force,
         }
     }
 }
@@ -191,6 +198,7 @@ pub fn fit(options: &FitOptions) -> Result<FitReport, AppError> {
         run.validate()?;
     }
     let problem = Problem::from_files(&options.data, &options.model)?;
+    super::plausible(&problem, options.force)?;
     let settings = model_settings(&problem, options)?;
     let mut posterior = problem.posterior(&settings)?;
     let map = map_estimate(&mut posterior)?;

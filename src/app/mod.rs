@@ -72,6 +72,24 @@ impl From<Error> for AppError {
     }
 }
 
+/// The plausibility check every command runs on its recordings first: its findings, one line
+/// each, as the error; with `force` they are returned for the report instead.
+pub fn plausible(
+    problem: &crate::study::Problem,
+    force: bool,
+) -> Result<Vec<crate::study::plausibility::Finding>, AppError> {
+    let findings = crate::study::plausibility::check(problem)?;
+    if findings.is_empty() || force {
+        return Ok(findings);
+    }
+    let lines: Vec<String> = findings.iter().map(|f| f.to_string()).collect();
+    Err(AppError::Usage(format!(
+        "{}
+these recordings cannot be this motor as set up: check the files (or --force)",
+        lines.join("\n")
+    )))
+}
+
 /// The flag of a settings field: `chains` → `--chains`, `keep/draws` → `--keep/--draws`.
 pub fn flag(field: &str) -> String {
     field

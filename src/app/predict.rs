@@ -24,6 +24,9 @@ pub struct PredictOptions {
     /// Write the residual table as JSON.
     #[arg(long)]
     pub json: Option<PathBuf>,
+    /// Go on when a recording cannot be this motor as set up.
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// `motorcal predict`: the residual table.
@@ -36,6 +39,7 @@ pub fn run(options: &PredictOptions) -> Result<(), AppError> {
 /// The whole command: read, simulate, report; writes nothing if anything fails before.
 pub fn predict(options: &PredictOptions) -> Result<Vec<ChannelResidual>, AppError> {
     let problem = Problem::from_files(&options.data, &options.model)?;
+    super::plausible(&problem, options.force)?;
     let predictions = predict_records(&problem)?;
     let table = residuals(&problem, &predictions);
     if let Some(path) = &options.csv {

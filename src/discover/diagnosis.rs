@@ -91,6 +91,9 @@ pub struct Diagnosis {
     pub ranking_s: f64,
     pub selection_s: f64,
     pub runtime_s: f64,
+    /// What the plausibility check found (only when the caller went on regardless).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub implausible: Vec<crate::study::plausibility::Finding>,
     /// The files the command wrote (the library writes none).
     pub outputs: Vec<String>,
     /// The sampled fits, in the order they ran, for the command's figures.
@@ -305,6 +308,7 @@ pub fn assemble(
         ranking_s,
         selection_s,
         runtime_s: 0.0,
+        implausible: settings.implausible.clone(),
         outputs: Vec::new(),
         fits: Vec::new(),
         missing_torque,

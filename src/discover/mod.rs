@@ -118,7 +118,13 @@ pub fn discover_with(
     ModelSettings::bm2(k)
         .validate()
         .map_err(|e| Error::setting("k", k, e))?;
-    let candidates = candidate_names(problem, settings.candidates.as_deref())?;
+    // A recording that cannot be this motor gets no candidate: whatever scored best would be
+    // physics named on top of a wrong file.
+    let candidates = if settings.implausible.is_empty() {
+        candidate_names(problem, settings.candidates.as_deref())?
+    } else {
+        Vec::new()
+    };
     progress(Progress::Ranking {
         candidates: candidates.len(),
     });

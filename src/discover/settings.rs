@@ -61,6 +61,9 @@ pub struct DiscoverSettings {
     pub run: RunSettings,
     /// Stop after the ranking, the selection and the ties: no sampled fits.
     pub rank_only: bool,
+    /// What `study::plausibility::check` found on the recordings, when the caller goes on
+    /// regardless: no physics is then selected on top of a fit that cannot be this motor.
+    pub implausible: Vec<crate::study::plausibility::Finding>,
 }
 
 impl Default for DiscoverSettings {
@@ -79,6 +82,7 @@ impl Default for DiscoverSettings {
                 ..RunSettings::default()
             },
             rank_only: false,
+            implausible: Vec::new(),
         }
     }
 }
