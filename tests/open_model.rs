@@ -7,12 +7,12 @@ use std::path::{Path, PathBuf};
 use motorcal::bayes::{CalibratedParameter, PriorInU};
 use motorcal::density::{DensityError, FisherMetric, LogDensity, StartingPoint};
 use motorcal::diagnostics::ParameterSummary;
-use motorcal::io::{Recording, write_recording};
+use motorcal::io::write_recording;
 use motorcal::motor::{ActiveTerm, MotorModel, MotorParameters, Term, VoltageInput};
 use motorcal::parameter::{ParamId, ParameterSpec, Prior, Support};
 use motorcal::pipeline::{RunOutput, RunSettings, SamplerKind, map_estimate, run_sampler};
 use motorcal::sampler::ChainSettings;
-use motorcal::study::Problem;
+use motorcal::study::{Problem, recording_from};
 use motorcal::synthetic::{generate, sample_times};
 use nalgebra::DMatrix;
 
@@ -70,18 +70,7 @@ fn record(dir: &Path, file: &str, terms: Vec<ActiveTerm>, input: VoltageInput, s
         VoltageInput::Held { values, .. } => Some(values),
         VoltageInput::Constant => None,
     };
-    let recording = Recording {
-        source: "test".into(),
-        time: times,
-        channels: data
-            .channel_names
-            .iter()
-            .cloned()
-            .zip(data.measured.iter().cloned())
-            .collect(),
-        voltage,
-        inputs: Vec::new(),
-    };
+    let recording = recording_from(&data, "test", voltage);
     write_recording(&dir.join(file), &recording).unwrap();
 }
 
