@@ -86,7 +86,9 @@ fn the_current_in_a_wrong_unit_is_named() {
     let scaled =
         |factor: f64| altered(move |r| channel(r, "I").iter_mut().for_each(|x| *x *= factor));
     assert_named(&findings(&scaled(1e3)), "I", "mA");
-    assert_named(&findings(&scaled(1e12)), "I", "does not follow");
+    // No factor we know: named as a scale the file does not state, by its order of magnitude.
+    assert_named(&findings(&scaled(1e12)), "I", "about 1e12");
+    assert_named(&findings(&scaled(-2.5e4)), "I", "about −1e4");
 }
 
 #[test]
@@ -187,7 +189,8 @@ fn the_real_records_are_plausible() {
 }
 
 /// The commands refuse such a recording with one line per finding and write nothing; with
-/// `--force` diagnose goes on, reports the findings and selects no physics.
+/// `--force` diagnose goes on, reports the findings and selects no physics, and fit keeps them in
+/// fit.json.
 #[test]
 fn diagnose_refuses_a_dead_recording_unless_forced() {
     let dir = std::env::temp_dir().join(format!("motorcal-plaus-{}", std::process::id()));
@@ -238,5 +241,36 @@ fn diagnose_refuses_a_dead_recording_unless_forced() {
         serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     assert_eq!(report["selected"], "none");
     assert!(!report["implausible"].as_array().unwrap().is_empty());
+
+    // fit: the same refusal, and with --force the findings go into fit.json.
+    let fit = |extra: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_motorcal"))
+            .args(["fit", "--map-only", "--bm", "1", "--data"])
+            .arg(&data)
+            .arg("--model")
+            .arg(case.join("motor.toml"))
+            .arg("--out")
+            .arg(dir.join("fit"))
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let refused = fit(&[]);
+    assert!(!refused.status.success());
+    assert!(!dir.join("fit/fit.json").exists(), "nothing written");
+    let forced = fit(&["--force"]);
+    let stdout = String::from_utf8_lossy(&forced.stdout);
+    assert!(
+        forced.status.success(),
+        "{}",
+        String::from_utf8_lossy(&forced.stderr)
+    );
+    assert!(
+        stdout.contains("implausible (went on with --force)"),
+        "{stdout}"
+    );
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("fit/fit.json")).unwrap()).unwrap();
+    assert!(report["implausible"][0]["finding"].is_string(), "{report}");
     std::fs::remove_dir_all(&dir).unwrap();
 }

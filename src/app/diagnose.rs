@@ -223,6 +223,16 @@ fn sig(v: f64) -> String {
 /// The human summary.
 pub fn format_diagnosis(d: &Diagnosis) -> String {
     let mut s = String::new();
+    if !d.implausible.is_empty() {
+        for finding in &d.implausible {
+            let _ = writeln!(s, "implausible (went on with --force): {finding}");
+        }
+        let _ = writeln!(
+            s,
+            "no physics is named on top of a recording that cannot be this motor as set up"
+        );
+        return s;
+    }
     let _ = writeln!(s, "ranking (score: log L − ½·d·ln N against none, nats):");
     for e in &d.ranking {
         let _ = write!(

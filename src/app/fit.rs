@@ -177,6 +177,9 @@ pub struct FitReport {
     pub divergences: Option<usize>,
     pub wall_seconds: Option<f64>,
     pub outputs: Vec<String>,
+    /// What the plausibility check found, when `--force` went on regardless.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub implausible: Vec<crate::study::plausibility::Finding>,
     pub provenance: Vec<(String, String)>,
 }
 
@@ -198,7 +201,7 @@ pub fn fit(options: &FitOptions) -> Result<FitReport, AppError> {
         run.validate()?;
     }
     let problem = Problem::from_files(&options.data, &options.model)?;
-    super::plausible(&problem, options.force)?;
+    let implausible = super::plausible(&problem, options.force)?;
     let settings = model_settings(&problem, options)?;
     let mut posterior = problem.posterior(&settings)?;
     let map = map_estimate(&mut posterior)?;
@@ -242,6 +245,7 @@ pub fn fit(options: &FitOptions) -> Result<FitReport, AppError> {
         divergences: None,
         wall_seconds: None,
         outputs: Vec::new(),
+        implausible,
         provenance: provenance(),
     };
     if let Some(run_settings) = &options.run {
@@ -360,6 +364,9 @@ pub fn format_report(report: &FitReport) -> String {
         "MAP: log density {:.3}, log likelihood {:.3}, Laplace log evidence {:.3}\n",
         report.map_log_density, report.map_log_likelihood, report.log_evidence_laplace
     ));
+    for finding in &report.implausible {
+        out.push_str(&format!("implausible (went on with --force): {finding}\n"));
+    }
     if report.summaries.is_empty() {
         out.push_str(&format!(
             "{:<24} {:>14} {:>12}\n",

@@ -20,7 +20,10 @@
 //!   this mistake" that, undone, leaves the channel on the model's scale, compared with the record as it is by the Gaussian log likelihood at each
 //!   channel's maximum-likelihood noise: −N/2·ln(RSS_fix / RSS_as_is). A cause is named when it
 //!   wins by more than [`EVIDENCE_NATS`]; the time in milliseconds is tested on every record,
-//!   since it leaves the scale alone.
+//!   since it leaves the scale alone. When no known factor explains an off-scale channel but
+//!   the scaled prediction still holds at least [`FOLLOWS_SHARE`] of its variation, the channel
+//!   is the model's shape at another scale: a unit or scaling the file does not state (named
+//!   by its order of magnitude); otherwise the channel does not follow the model at all.
 //!
 //! A record that passes keeps its diagnosis untouched: nothing here changes the problem.
 
@@ -49,6 +52,12 @@ pub const SCALE_FLOOR: f64 = 1.0 / 30.0;
 /// factor of e¹⁰ ≈ 22 000, for a handful of hypotheses tested at once. The mistakes this
 /// names lead by thousands of nats on a 501-sample record.
 pub const EVIDENCE_NATS: f64 = 10.0;
+
+/// The share of a channel's variation the scaled prediction must hold for the channel to be
+/// called the model's shape at another scale: noise, or another quantity, holds next to none of
+/// it (pure noise a few per cent at most on 501 samples); a scaled record of this motor nearly
+/// all of it. A half is far from both.
+pub const FOLLOWS_SHARE: f64 = 0.5;
 
 /// rad/s recorded as rpm: the value is 60/(2π) times larger.
 const RPM_PER_RAD_S: f64 = 60.0 / (2.0 * std::f64::consts::PI);
@@ -106,6 +115,17 @@ fn log_likelihood(n: usize, rss: f64) -> f64 {
 /// How much better a hypothesis explains the record than the record as it is (nats).
 fn lead(n: usize, rss_fix: f64, rss_as_is: f64) -> f64 {
     log_likelihood(n, rss_fix) - log_likelihood(n, rss_as_is)
+}
+
+/// The share of a channel's variation the prediction at `scale` explains (R²).
+fn explained_share(y: &[f64], g: &[f64], scale: f64) -> f64 {
+    let m = mean(y);
+    let total: f64 = y.iter().map(|v| (v - m).powi(2)).sum();
+    if total > 0.0 {
+        1.0 - rss(y, g, scale) / total
+    } else {
+        0.0
+    }
 }
 
 /// The unit and sign mistakes tested, as (factor the record carries, its cause).
@@ -227,6 +247,24 @@ fn check_record(problem: &Problem, p: &RecordPrediction) -> Vec<Finding> {
                 likely_cause: cause,
                 evidence: Some(evidence),
             }),
+            // No factor we know, but the channel is the model's shape at another scale: it
+            // holds most of its variation (R² ≥ ½ for the scaled prediction), which noise or
+            // another quantity would not.
+            _ if explained_share(measured, predicted, scale) >= FOLLOWS_SHARE => {
+                let order = 10f64.powi(scale.abs().log10().round() as i32);
+                findings.push(Finding {
+                    record: p.source.clone(),
+                    channel: name.clone(),
+                    finding: format!("{name} follows the model's shape, scaled: {expected}"),
+                    likely_cause: format!(
+                        "{name} carries a unit or scale factor of about {}{order:e} that the \
+                         file does not state: check the logger's scaling and the column's unit \
+                         ({unit} expected)",
+                        if scale < 0.0 { "−" } else { "" }
+                    ),
+                    evidence: Some(lead(n, rss(measured, predicted, scale), as_is)),
+                })
+            }
             _ => findings.push(Finding {
                 record: p.source.clone(),
                 channel: name.clone(),
