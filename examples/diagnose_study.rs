@@ -34,6 +34,8 @@ struct Row {
     selected_set: Vec<String>,
     ties: Vec<String>,
     right: bool,
+    /// The third verdict's fingerprint kind, when the selected model leaves structure.
+    unexplained: Option<String>,
     runtime_s: f64,
 }
 
@@ -155,16 +157,23 @@ fn main() {
             selected: d.selected.clone(),
             selected_set: d.selected_set.clone(),
             ties: d.ties.clone(),
+            unexplained: d.unexplained.as_ref().map(|u| {
+                serde_json::to_value(&u.fingerprint).unwrap()["kind"]
+                    .as_str()
+                    .unwrap_or("?")
+                    .to_string()
+            }),
             runtime_s: d.runtime_s,
         };
         eprintln!(
-            "{} {:?} → {} {:?} ties {:?} {} ({:.1} s)",
+            "{} {:?} → {} {:?} ties {:?} {} unexplained {:?} ({:.1} s)",
             row.set,
             row.truth,
             row.selected,
             row.selected_set,
             row.ties,
             if row.right { "right" } else { "WRONG" },
+            row.unexplained,
             row.runtime_s
         );
         row
@@ -208,7 +217,7 @@ fn main() {
     rows.extend(two_rows);
 
     let dev = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/concealed-dev");
-    if dev.is_dir() {
+    if dev.is_dir() && !args.iter().any(|a| a == "--skip-dev") {
         for i in 1..=14 {
             let dir = dev.join(format!("case{i:02}"));
             let answer: serde_json::Value =
@@ -242,11 +251,17 @@ fn main() {
                 selected: d.selected.clone(),
                 selected_set: d.selected_set.clone(),
                 ties: d.ties.clone(),
+                unexplained: d.unexplained.as_ref().map(|u| {
+                    serde_json::to_value(&u.fingerprint).unwrap()["kind"]
+                        .as_str()
+                        .unwrap_or("?")
+                        .to_string()
+                }),
                 runtime_s: d.runtime_s,
             };
             eprintln!(
-                "dev {} {:?} → {} ({:.1} s)",
-                row.case, row.truth, row.selected, row.runtime_s
+                "dev {} {:?} → {} unexplained {:?} ({:.1} s)",
+                row.case, row.truth, row.selected, row.unexplained, row.runtime_s
             );
             rows.push(row);
         }
@@ -254,11 +269,11 @@ fn main() {
 
     std::fs::create_dir_all(&out).unwrap();
     let mut csv = String::from(
-        "set,case,truth,seed,input,input_fallback,peak_over_sigma,oracle_margin,selected,selected_set,ties,right,runtime_s\n",
+        "set,case,truth,seed,input,input_fallback,peak_over_sigma,oracle_margin,selected,selected_set,ties,right,unexplained,runtime_s\n",
     );
     for r in &rows {
         csv.push_str(&format!(
-            "{},{},{},{},{},{},{:.3},{},{},{},{},{},{:.2}\n",
+            "{},{},{},{},{},{},{:.3},{},{},{},{},{},{},{:.2}\n",
             r.set,
             r.case,
             r.truth.join("+"),
@@ -273,6 +288,7 @@ fn main() {
             r.selected_set.join("+"),
             r.ties.join("+"),
             r.right,
+            r.unexplained.clone().unwrap_or_default(),
             r.runtime_s
         ));
     }
@@ -291,8 +307,9 @@ fn main() {
         let right = of.iter().filter(|r| r.right).count();
         let mut times: Vec<f64> = of.iter().map(|r| r.runtime_s).collect();
         times.sort_by(f64::total_cmp);
+        let unexplained = of.iter().filter(|r| r.unexplained.is_some()).count();
         println!(
-            "\n{set}: {right}/{} right ({:.0}%); runtime median {:.1} s, max {:.1} s",
+            "\n{set}: {right}/{} right ({:.0}%); unexplained {unexplained}; runtime median {:.1} s, max {:.1} s",
             of.len(),
             100.0 * right as f64 / of.len() as f64,
             times[times.len() / 2],

@@ -251,7 +251,14 @@ pub fn format_diagnosis(d: &Diagnosis) -> String {
             None => s.push('\n'),
         }
     }
-    if d.selected_set.is_empty() {
+    if d.selected_set.is_empty() && d.unexplained.is_some() {
+        let _ = writeln!(
+            s,
+            "no library term beats the model as it is by more than {} nats, but something is \
+             missing that the library does not hold:",
+            d.threshold
+        );
+    } else if d.selected_set.is_empty() {
         let _ = writeln!(
             s,
             "no candidate beats the model as it is by more than {} nats: nothing missing found",
@@ -282,6 +289,29 @@ pub fn format_diagnosis(d: &Diagnosis) -> String {
                     ci[1]
                 );
             }
+        }
+    }
+    if let Some(u) = &d.unexplained {
+        let _ = writeln!(
+            s,
+            "unexplained: {:+.1} nats left on {} that no library term holds; {}",
+            u.evidence,
+            u.channels.join(" and "),
+            u.suggestion
+        );
+        for f in std::iter::once(&u.fingerprint).chain(&u.alternatives) {
+            let _ = writeln!(
+                s,
+                "  fingerprint: {}",
+                serde_json::to_string(f).unwrap_or_default()
+            );
+        }
+        for w in &u.spans {
+            let _ = writeln!(
+                s,
+                "  where: {} from {:.4} s to {:.4} s",
+                w.channel, w.t_start, w.t_end
+            );
         }
     }
     if let (Some(b), Some(a)) = (&d.fit_before, &d.fit_after) {

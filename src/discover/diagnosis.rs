@@ -25,6 +25,7 @@ use super::settings::{
 };
 use super::state::{StateFingerprint, fingerprint, reading};
 use super::ties::separating_input;
+use super::unexplained::{Unexplained, unexplained};
 
 #[derive(Clone, Debug, Serialize)]
 pub struct RankEntry {
@@ -78,6 +79,13 @@ pub struct Diagnosis {
     pub fit_before: Option<FitSummary>,
     pub fit_after: Option<FitSummary>,
     pub notes: Vec<String>,
+    /// Structure the selected model leaves that no library term holds (`unexplained`).
+    pub unexplained: Option<Unexplained>,
+    /// The law term discovered from a state fingerprint, when one was added (not yet built:
+    /// always null).
+    pub discovered: Option<serde_json::Value>,
+    /// True whenever `unexplained` is not null, or δ's band after the selected terms still
+    /// excludes zero on a stretch of the record.
     pub residual_mismatch: bool,
     pub convergence: BTreeMap<String, Convergence>,
     pub threshold: f64,
@@ -285,6 +293,7 @@ pub fn assemble(
             tie_experiments.insert(pair.join("/"), "reversal".into());
         }
     }
+    let left = unexplained(problem, &selected_fit, &none)?;
     let mut diagnosis = Diagnosis {
         selected,
         selected_set: selected_set.clone(),
@@ -299,7 +308,9 @@ pub fn assemble(
         fit_before: None,
         fit_after: None,
         notes,
-        residual_mismatch: false,
+        residual_mismatch: left.is_some(),
+        unexplained: left,
+        discovered: None,
         convergence: BTreeMap::new(),
         threshold: EVIDENCE_THRESHOLD,
         units: parameter_units(&selected_fit.problem)?,
@@ -382,7 +393,7 @@ fn sampled_fits(
             FitStage::BeforeBm2 => {
                 let (mismatch, _) = fits::mismatches(problem, &mut fit)?;
                 if diagnosis.selected_set.is_empty() {
-                    diagnosis.residual_mismatch =
+                    diagnosis.residual_mismatch |=
                         mismatch.iter().any(|m| fits::substantial(m, problem));
                 }
                 diagnosis.mismatch = mismatch;
@@ -393,7 +404,7 @@ fn sampled_fits(
                     .iter()
                     .filter(|m| fits::substantial(m, problem))
                     .collect();
-                diagnosis.residual_mismatch = !substantial.is_empty();
+                diagnosis.residual_mismatch |= !substantial.is_empty();
                 for m in substantial {
                     diagnosis.notes.push(format!(
                         "after the selected terms δ still excludes zero on {} from {:.4} s to \

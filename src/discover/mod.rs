@@ -58,6 +58,7 @@ mod selection;
 mod settings;
 mod state;
 mod ties;
+mod unexplained;
 
 use std::time::Instant;
 
@@ -72,6 +73,7 @@ pub use settings::{
     LAPLACE_DRAWS, MAX_TERMS, METRIC_ADAPTATION, MIN_SAMPLES, candidate_names, uses_laplace,
 };
 pub use state::{StateFingerprint, records_reverse};
+pub use unexplained::{Fingerprint, Span, Unexplained};
 
 use crate::bayes::ModelSettings;
 use crate::error::Error;

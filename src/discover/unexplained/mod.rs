@@ -1,0 +1,497 @@
+//! The third verdict: structure the selected model leaves that no term of the library holds.
+//!
+//! After the forward selection (or with nothing selected) the selected model's MAP residuals
+//! are asked whether generic alternatives that can hold "anything" explain them better than
+//! white noise: a discrepancy polynomial in time per channel (degrees up to a tenth of the
+//! samples), an autoregression of the residual (p = 1, 2, 4, 8), a sinusoid through the record
+//! and a damped sinusoid ringing after each input step (`oscillation`), every channel late by
+//! τ (an input delay) and one channel filtered with time constant τ (a sensor lag). Each is
+//! scored as the ranking scores a term: its linearised gain in log likelihood with the model's
+//! parameters refitted beside it (`regression`), less ½·ln N per degree of freedom, less the
+//! logarithm of the grid a search ran over. The same alternatives are scored on the model as
+//! given, less the score the selected terms gained over it: an effect the library holds only
+//! in part (a term selected that absorbs most of it) then still shows.
+//!
+//! **The threshold** is the ranking's, [`EVIDENCE_THRESHOLD`] (2 nats), fixed before any case
+//! was run, for the same reason. Under the model each alternative's gain is ½χ²_d; with the
+//! BIC penalty at N = 1002 a one-degree alternative clears it with probability
+//! P(χ²₁ > 2·(3.45 + 2)) ≈ 0.1%, a searched sinusoid with about the same (its grid's multiplicity
+//! is paid for), and the larger alternatives far less often. About twenty alternatives per
+//! record, most nested in one another, give a false alarm on a null record of about 1–2%,
+//! which with the ranking's 1% stays within the 5% asked for.
+//!
+//! The **fingerprint** is the specific alternative (oscillation, delay, lag) with the best
+//! score, unless a generic one (polynomial, autoregression) beats every specific one by more
+//! than the threshold: then the kind is `unknown`. Others within the threshold of the leader
+//! are listed as alternatives.
+
+mod oscillation;
+mod regression;
+
+use nalgebra::{DMatrix, DVector};
+use serde::Serialize;
+
+use crate::bayes::{DiscrepancyBasis, Legendre};
+use crate::error::Error;
+use crate::study::Problem;
+
+use super::candidate::Candidate;
+use super::coincide::input_steps;
+use super::fits::MISMATCH_MIN_SHARE;
+use super::settings::EVIDENCE_THRESHOLD;
+use oscillation::Oscillation;
+use regression::{Explained, Projector, explain};
+
+/// Input steps (besides the record's start) a ringing oscillation is fitted after at most: the
+/// largest ones; a long real record's many small steps ring too little to matter.
+const MAX_STEPS: usize = 6;
+/// Autoregression orders tried.
+const AR_ORDERS: [usize; 4] = [1, 2, 4, 8];
+/// Polynomial degrees tried (those below a tenth of the samples).
+const DEGREES: [usize; 6] = [2, 4, 8, 16, 24, 32];
+
+/// An alternative's explained part and its score (gain − penalty, nats).
+#[derive(Clone, Debug)]
+pub struct Scored {
+    pub explained: Explained,
+    pub score: f64,
+}
+
+impl Scored {
+    pub fn new(explained: Explained, penalty: f64) -> Self {
+        let score = explained.gain - penalty;
+        Self { explained, score }
+    }
+}
+
+/// One record's residuals at a model's MAP, whitened and stacked channel after channel, with
+/// the model's whitened sensitivities to project alternatives against.
+pub struct Context {
+    pub times: Vec<f64>,
+    pub n: usize,
+    pub channels: Vec<String>,
+    pub sigma: Vec<f64>,
+    /// Each channel's prediction (observed − residual), in its own unit.
+    pub prediction: Vec<Vec<f64>>,
+    pub y: DVector<f64>,
+    /// y with the part the model's parameters can still take removed.
+    pub y_perp: DVector<f64>,
+    pub projector: Projector,
+    /// The record's start and its largest input steps [s].
+    pub steps: Vec<f64>,
+    pub ln_n: f64,
+}
+
+impl Context {
+    pub fn m(&self) -> usize {
+        self.n * self.channels.len()
+    }
+
+    fn of(problem: &Problem, fit: &Candidate, record: usize) -> Result<Self, Error> {
+        let mut posterior = fit.posterior.clone();
+        let x = &fit.map.x;
+        let residuals = posterior.residuals(x, record)?;
+        let names = posterior.channel_names(record);
+        let forward = posterior.forward(record).clone();
+        let theta = posterior.theta_of(x);
+        let mut outputs = vec![0.0; forward.n_outputs()];
+        let mut jacobian = DMatrix::zeros(forward.n_outputs(), forward.n_calibrated());
+        forward
+            .simulate_with_sensitivities(&theta, &mut outputs, &mut jacobian)
+            .map_err(|e| Error::Numerical(format!("the unexplained-structure check: {e}")))?;
+        let n = forward.n_samples();
+        let times = forward.times().to_vec();
+        let m = n * names.len();
+        let mut y = DVector::zeros(m);
+        let mut j = DMatrix::zeros(m, forward.n_calibrated());
+        let mut sigma = Vec::new();
+        let mut prediction = Vec::new();
+        for (c, name) in names.iter().enumerate() {
+            let s = x[posterior.log_sigma_index(record, c)].exp();
+            let k = forward
+                .channels()
+                .iter()
+                .position(|f| f == name)
+                .ok_or_else(|| Error::Numerical(format!("channel {name} is not simulated")))?;
+            let observed = posterior.observed(record, c);
+            for i in 0..n {
+                y[c * n + i] = residuals[c][i] / s;
+                for p in 0..forward.n_calibrated() {
+                    j[(c * n + i, p)] = jacobian[(k * n + i, p)] / s;
+                }
+            }
+            sigma.push(s);
+            prediction.push((0..n).map(|i| observed[i] - residuals[c][i]).collect());
+        }
+        let projector = Projector::new(j);
+        let y_perp = DVector::from_column_slice(
+            projector
+                .residualize(&DMatrix::from_column_slice(m, 1, y.as_slice()))
+                .as_slice(),
+        );
+        let recording = &problem.recordings[record];
+        let mut steps: Vec<(f64, f64)> = input_steps(problem, recording)
+            .into_iter()
+            .filter(|s| !s.record_start)
+            .map(|s| (s.time, s.size.abs()))
+            .collect();
+        steps.sort_by(|a, b| b.1.total_cmp(&a.1));
+        steps.truncate(MAX_STEPS);
+        let mut steps: Vec<f64> = std::iter::once(0.0)
+            .chain(steps.into_iter().map(|s| s.0))
+            .collect();
+        steps.sort_by(f64::total_cmp);
+        Ok(Self {
+            times,
+            n,
+            channels: names,
+            sigma,
+            prediction,
+            y,
+            y_perp,
+            projector,
+            steps,
+            ln_n: (problem.n_observations() as f64).ln(),
+        })
+    }
+
+    fn score(&self, b: &DMatrix<f64>, extra_penalty: f64) -> Scored {
+        let e = explain(&self.y, &self.projector.residualize(b));
+        let penalty = 0.5 * e.rank as f64 * self.ln_n + extra_penalty;
+        Scored::new(e, penalty)
+    }
+
+    /// Columns `values` (n × d) placed in channel c's rows.
+    fn in_channel(&self, c: usize, values: &DMatrix<f64>) -> DMatrix<f64> {
+        let mut b = DMatrix::zeros(self.m(), values.ncols());
+        b.view_mut((c * self.n, 0), (self.n, values.ncols()))
+            .copy_from(values);
+        b
+    }
+
+    /// dŷ/dt of channel c (central differences on the sample grid), whitened.
+    fn derivative(&self, c: usize) -> Vec<f64> {
+        let (t, y) = (&self.times, &self.prediction[c]);
+        let n = self.n;
+        (0..n)
+            .map(|i| {
+                let (a, b) = (i.saturating_sub(1), (i + 1).min(n - 1));
+                (y[b] - y[a]) / (t[b] - t[a]) / self.sigma[c]
+            })
+            .collect()
+    }
+}
+
+/// A generic alternative's result: the best polynomial or autoregression of a channel.
+struct Generic {
+    channel: usize,
+    polynomial: bool,
+    scored: Scored,
+}
+
+/// Where the best polynomial of a channel departs from zero by more than two of its sds.
+#[derive(Clone, Debug, Serialize)]
+pub struct Span {
+    pub channel: String,
+    pub t_start: f64,
+    pub t_end: f64,
+}
+
+/// The leading kinds of structure left, each with its own score (nats over the model).
+#[derive(Clone, Debug, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Fingerprint {
+    Oscillation {
+        frequency_hz: f64,
+        frequency_sd: f64,
+        damping_ratio: Option<f64>,
+        channel: String,
+        ringing: bool,
+        score: f64,
+    },
+    Delay {
+        seconds: f64,
+        sd: f64,
+        score: f64,
+    },
+    Lag {
+        channel: String,
+        seconds: f64,
+        sd: f64,
+        score: f64,
+    },
+    Unknown {
+        score: f64,
+    },
+}
+
+impl Fingerprint {
+    pub fn score(&self) -> f64 {
+        match self {
+            Fingerprint::Oscillation { score, .. }
+            | Fingerprint::Delay { score, .. }
+            | Fingerprint::Lag { score, .. }
+            | Fingerprint::Unknown { score } => *score,
+        }
+    }
+
+    /// What a user might do about it, in a sentence.
+    pub fn suggestion(&self, channels: &[String]) -> String {
+        match self {
+            Fingerprint::Oscillation {
+                frequency_hz,
+                damping_ratio,
+                channel,
+                ringing: true,
+                ..
+            } => format!(
+                "a resonance at {frequency_hz:.1} Hz (damping ratio {:.3}) rings on {channel} \
+                 after the input steps: a compliant coupling to the load (the term \
+                 compliant_coupling) or a resonant sensor; a record with sharper steps, or \
+                 with the load decoupled, would tell them apart",
+                damping_ratio.unwrap_or(f64::NAN)
+            ),
+            Fingerprint::Oscillation {
+                frequency_hz,
+                channel,
+                ..
+            } => format!(
+                "a periodic disturbance at {frequency_hz:.1} Hz runs on {channel} regardless \
+                 of the input: a pulsing load, an eccentric or cogging (compare it with the \
+                 turning frequency ω/2π), or interference on the sensor"
+            ),
+            Fingerprint::Delay { seconds, .. } => format!(
+                "every channel is late by {:.3} ms: the input acts later than modelled (the \
+                 term input_delay)",
+                seconds * 1e3
+            ),
+            Fingerprint::Lag {
+                channel, seconds, ..
+            } => format!(
+                "{channel} lags the model with a time constant of {:.3} ms: a filter in its \
+                 sensor or logger (the term sensor_lag on {channel})",
+                seconds * 1e3
+            ),
+            Fingerprint::Unknown { .. } => format!(
+                "structure no library term holds remains in {}: a record with another input \
+                 (a reversal, steps of several sizes) would show how it depends on the state",
+                channels.join(" and ")
+            ),
+        }
+    }
+}
+
+/// The verdict's report: `null` in the JSON when nothing is left.
+#[derive(Clone, Debug, Serialize)]
+pub struct Unexplained {
+    /// The leading alternative's score over the selected model (nats).
+    pub evidence: f64,
+    pub channels: Vec<String>,
+    #[serde(rename = "where")]
+    pub spans: Vec<Span>,
+    pub fingerprint: Fingerprint,
+    pub alternatives: Vec<Fingerprint>,
+    pub suggestion: String,
+}
+
+/// Everything scored on one model's residuals: the fingerprints and the generic alternatives.
+struct Scores {
+    fingerprints: Vec<Fingerprint>,
+    generic: Vec<Generic>,
+}
+
+fn scores(ctx: &Context, shift: f64) -> Scores {
+    let mut fingerprints = Vec::new();
+    let mut generic = Vec::new();
+    let n = ctx.n;
+    let span = ctx.times[n - 1];
+    for c in 0..ctx.channels.len() {
+        let name = ctx.channels[c].clone();
+        for k in DEGREES.iter().copied().filter(|k| (k + 1) * 10 <= n) {
+            let Ok(basis) = Legendre::new(k, span) else {
+                continue;
+            };
+            let b = ctx.in_channel(c, &basis.matrix(&ctx.times));
+            generic.push(Generic {
+                channel: c,
+                polynomial: true,
+                scored: ctx.score(&b, 0.0),
+            });
+        }
+        for p in AR_ORDERS.iter().copied().filter(|p| p * 10 <= n) {
+            let lags = DMatrix::from_fn(
+                n,
+                p,
+                |i, l| {
+                    if i > l { ctx.y[c * n + i - l - 1] } else { 0.0 }
+                },
+            );
+            generic.push(Generic {
+                channel: c,
+                polynomial: false,
+                scored: ctx.score(&ctx.in_channel(c, &lags), 0.0),
+            });
+        }
+        for o in oscillation::search(ctx, c) {
+            fingerprints.push(oscillation_fingerprint(&o, &name, shift));
+        }
+        // A lag: y_measured ≈ ŷ − τ·dŷ/dt on this channel alone (τ > 0).
+        let d = DMatrix::from_column_slice(n, 1, &ctx.derivative(c));
+        let s = ctx.score(&ctx.in_channel(c, &d), 0.0);
+        if s.explained.coefficients[0] < 0.0 {
+            fingerprints.push(Fingerprint::Lag {
+                channel: name,
+                seconds: -s.explained.coefficients[0],
+                sd: s.explained.sd[0],
+                score: s.score - shift,
+            });
+        }
+    }
+    // A delay: every channel late by the same τ.
+    let mut d = DMatrix::zeros(ctx.m(), 1);
+    for c in 0..ctx.channels.len() {
+        for (i, v) in ctx.derivative(c).into_iter().enumerate() {
+            d[(c * n + i, 0)] = v;
+        }
+    }
+    let s = ctx.score(&d, 0.0);
+    if s.explained.coefficients[0] < 0.0 && ctx.channels.len() > 1 {
+        fingerprints.push(Fingerprint::Delay {
+            seconds: -s.explained.coefficients[0],
+            sd: s.explained.sd[0],
+            score: s.score - shift,
+        });
+    }
+    for g in &mut generic {
+        g.scored.score -= shift;
+    }
+    Scores {
+        fingerprints,
+        generic,
+    }
+}
+
+fn oscillation_fingerprint(o: &Oscillation, channel: &str, shift: f64) -> Fingerprint {
+    Fingerprint::Oscillation {
+        frequency_hz: o.frequency_hz,
+        frequency_sd: o.frequency_sd,
+        damping_ratio: o.damping_ratio(),
+        channel: channel.to_string(),
+        ringing: o.ringing(),
+        score: o.scored.score - shift,
+    }
+}
+
+/// Samples where a fitted curve departs from zero by more than two of its sds, as intervals of
+/// at least `MISMATCH_MIN_SHARE` of the record.
+fn spans(ctx: &Context, c: usize, e: &Explained) -> Vec<Span> {
+    let n = ctx.n;
+    let duration = ctx.times[n - 1] - ctx.times[0];
+    let mut out = Vec::new();
+    let mut start: Option<usize> = None;
+    for i in 0..=n {
+        let off = i < n && {
+            let k = c * n + i;
+            e.fitted[k].abs() > 2.0 * e.fitted_sd[k]
+        };
+        match (off, start) {
+            (true, None) => start = Some(i),
+            (false, Some(s)) => {
+                let (a, b) = (ctx.times[s], ctx.times[i - 1]);
+                if b - a >= MISMATCH_MIN_SHARE * duration {
+                    out.push(Span {
+                        channel: ctx.channels[c].clone(),
+                        t_start: a,
+                        t_end: b,
+                    });
+                }
+                start = None;
+            }
+            _ => {}
+        }
+    }
+    out
+}
+
+/// The verdict on the first record: `None` when the selected model leaves nothing a generic
+/// alternative finds, by more than the threshold, on it or on the model as given.
+pub fn unexplained(
+    problem: &Problem,
+    selected: &Candidate,
+    none: &Candidate,
+) -> Result<Option<Unexplained>, Error> {
+    if problem.recordings.is_empty() {
+        return Ok(None);
+    }
+    let ctx = Context::of(problem, selected, 0)?;
+    if ctx.n < 20 {
+        return Ok(None);
+    }
+    let mut all = scores(&ctx, 0.0);
+    if !selected.added.is_empty() {
+        // What the selected terms gained over the model as given is the bar an alternative on
+        // the model as given must clear to count against them.
+        let none_ctx = Context::of(problem, none, 0)?;
+        let on_none = scores(&none_ctx, selected.score - none.score);
+        all.fingerprints.extend(on_none.fingerprints);
+    }
+    let best_generic = all
+        .generic
+        .iter()
+        .max_by(|a, b| a.scored.score.total_cmp(&b.scored.score));
+    let mut candidates: Vec<Fingerprint> = all.fingerprints;
+    if let Some(g) = best_generic {
+        candidates.push(Fingerprint::Unknown {
+            score: g.scored.score - EVIDENCE_THRESHOLD,
+        });
+    }
+    candidates.sort_by(|a, b| b.score().total_cmp(&a.score()));
+    let evidence = candidates
+        .iter()
+        .map(Fingerprint::score)
+        .chain(best_generic.map(|g| g.scored.score))
+        .fold(f64::NEG_INFINITY, f64::max);
+    if !(evidence > EVIDENCE_THRESHOLD) {
+        return Ok(None);
+    }
+    let lead = candidates[0].score();
+    let fingerprint = candidates[0].clone();
+    let alternatives: Vec<Fingerprint> = candidates[1..]
+        .iter()
+        .filter(|f| f.score() > EVIDENCE_THRESHOLD && lead - f.score() <= EVIDENCE_THRESHOLD)
+        .cloned()
+        .collect();
+    // Channels: those whose own best generic alternative clears the threshold.
+    let mut channels = Vec::new();
+    let mut where_ = Vec::new();
+    for c in 0..ctx.channels.len() {
+        let best = all
+            .generic
+            .iter()
+            .filter(|g| g.channel == c)
+            .max_by(|a, b| a.scored.score.total_cmp(&b.scored.score));
+        if best.is_some_and(|g| g.scored.score > EVIDENCE_THRESHOLD) {
+            channels.push(ctx.channels[c].clone());
+            let polynomial = all
+                .generic
+                .iter()
+                .filter(|g| g.channel == c && g.polynomial)
+                .max_by(|a, b| a.scored.score.total_cmp(&b.scored.score));
+            if let Some(g) = polynomial {
+                where_.extend(spans(&ctx, c, &g.scored.explained));
+            }
+        }
+    }
+    if channels.is_empty() {
+        channels = ctx.channels.clone();
+    }
+    let suggestion = fingerprint.suggestion(&channels);
+    Ok(Some(Unexplained {
+        evidence,
+        channels,
+        spans: where_,
+        fingerprint,
+        alternatives,
+        suggestion,
+    }))
+}

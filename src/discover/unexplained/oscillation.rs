@@ -1,0 +1,190 @@
+//! Oscillations the model does not hold: a sinusoid that runs through the record (a periodic
+//! load, an eccentric) and a damped sinusoid that rings after each input step (a resonance).
+//! Both are searched on a grid of frequencies (and decay rates), refined, and scored by the
+//! exact linearised gain of `regression`; the search's look-elsewhere cost is the logarithm of
+//! the number of grid points, so that the best of many null periodogram ordinates (each ½χ²₂,
+//! i.e. exponential with mean 1) clears the threshold as rarely as one fixed alternative would.
+
+use std::f64::consts::PI;
+
+use nalgebra::DMatrix;
+
+use super::regression::{explain, gain};
+use super::{Context, Scored};
+
+/// Frequencies searched at most (the grid's step grows beyond it on long records).
+const MAX_FREQUENCIES: usize = 2048;
+/// Grid points per 1/T (the Fourier spacing): four, so that a peak between two Fourier
+/// frequencies loses little before refinement.
+const OVERSAMPLING: f64 = 4.0;
+/// Decay times searched, in periods of the oscillation: ζ from about 0.3 to 0.005.
+const DECAY_PERIODS: [f64; 7] = [0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0];
+/// Golden-section steps of a refinement.
+const REFINE_STEPS: usize = 40;
+
+/// A fitted oscillation in one channel.
+#[derive(Clone, Debug)]
+pub struct Oscillation {
+    pub frequency_hz: f64,
+    pub frequency_sd: f64,
+    /// The decay rate λ [1/s] of a ringing oscillation (none for one that runs on).
+    pub decay: Option<f64>,
+    pub scored: Scored,
+}
+
+impl Oscillation {
+    pub fn ringing(&self) -> bool {
+        self.decay.is_some()
+    }
+
+    /// ζ of a ringing oscillation: λ = ζ·ω_n, ω_d = ω_n·√(1 − ζ²).
+    pub fn damping_ratio(&self) -> Option<f64> {
+        let w = 2.0 * PI * self.frequency_hz;
+        self.decay.map(|l| l / (l * l + w * w).sqrt())
+    }
+}
+
+/// The columns of a sinusoid at f (decaying at λ after each step when given), in channel c's
+/// rows of the stacked output.
+fn columns(ctx: &Context, c: usize, f: f64, decay: Option<f64>) -> DMatrix<f64> {
+    let n = ctx.n;
+    let w = 2.0 * PI * f;
+    match decay {
+        None => {
+            let mut b = DMatrix::zeros(ctx.m(), 2);
+            for (i, &t) in ctx.times.iter().enumerate() {
+                let (s, co) = (w * t).sin_cos();
+                b[(c * n + i, 0)] = co;
+                b[(c * n + i, 1)] = s;
+            }
+            b
+        }
+        Some(l) => {
+            let mut b = DMatrix::zeros(ctx.m(), 2 * ctx.steps.len());
+            for (k, &ts) in ctx.steps.iter().enumerate() {
+                for (i, &t) in ctx.times.iter().enumerate() {
+                    if t < ts {
+                        continue;
+                    }
+                    let tau = t - ts;
+                    let envelope = (-l * tau).exp();
+                    if envelope < 1e-4 {
+                        break;
+                    }
+                    let (s, co) = (w * tau).sin_cos();
+                    b[(c * n + i, 2 * k)] = envelope * co;
+                    b[(c * n + i, 2 * k + 1)] = envelope * s;
+                }
+            }
+            b
+        }
+    }
+}
+
+/// The quick gain used by the search: channel c's projected residual regressed on the
+/// unprojected columns (the exact score is computed once, at the end).
+fn quick_gain(ctx: &Context, c: usize, f: f64, decay: Option<f64>) -> f64 {
+    let b = columns(ctx, c, f, decay);
+    let rows = c * ctx.n..(c + 1) * ctx.n;
+    let b = b.rows(rows.start, ctx.n).into_owned();
+    let y = ctx.y_perp.rows(rows.start, ctx.n).into_owned();
+    gain(&y, &b)
+}
+
+fn golden(lo: f64, hi: f64, mut g: impl FnMut(f64) -> f64) -> f64 {
+    let r = (5f64.sqrt() - 1.0) / 2.0;
+    let (mut a, mut b) = (lo, hi);
+    let (mut x1, mut x2) = (b - r * (b - a), a + r * (b - a));
+    let (mut g1, mut g2) = (g(x1), g(x2));
+    for _ in 0..REFINE_STEPS {
+        if g1 > g2 {
+            b = x2;
+            (x2, g2) = (x1, g1);
+            x1 = b - r * (b - a);
+            g1 = g(x1);
+        } else {
+            a = x1;
+            (x1, g1) = (x2, g2);
+            x2 = a + r * (b - a);
+            g2 = g(x2);
+        }
+    }
+    (a + b) / 2.0
+}
+
+/// The best oscillation of each kind (running on, ringing) in channel c.
+pub fn search(ctx: &Context, c: usize) -> Vec<Oscillation> {
+    let span = ctx.times[ctx.n - 1] - ctx.times[0];
+    let dt = span / (ctx.n - 1).max(1) as f64;
+    let nyquist = 0.5 / dt;
+    // Below two periods over the record an oscillation is a trend (the polynomial's).
+    let f_min = 2.0 / span;
+    let step = (1.0 / (OVERSAMPLING * span)).max((nyquist - f_min) / MAX_FREQUENCIES as f64);
+    let grid: Vec<f64> = (0..)
+        .map(|k| f_min + k as f64 * step)
+        .take_while(|&f| f < nyquist)
+        .collect();
+    if grid.is_empty() {
+        return Vec::new();
+    }
+    let mut out = Vec::new();
+    let kinds: Vec<Option<f64>> = if ctx.steps.is_empty() {
+        vec![None]
+    } else {
+        std::iter::once(None)
+            .chain(DECAY_PERIODS.iter().map(|&p| Some(p)))
+            .collect()
+    };
+    // Running on: one search over f. Ringing: over f and the decay time in periods.
+    for ringing in [false, true] {
+        let mut best = (f64::NEG_INFINITY, grid[0], None);
+        let mut points = 0usize;
+        for &f in &grid {
+            for &periods in kinds.iter().filter(|k| k.is_some() == ringing) {
+                let decay = periods.map(|p| f / p);
+                points += 1;
+                let g = quick_gain(ctx, c, f, decay);
+                if g > best.0 {
+                    best = (g, f, decay);
+                }
+            }
+        }
+        if points == 0 {
+            continue;
+        }
+        let (_, mut f, mut decay) = best;
+        f = golden((f - step).max(f_min / 2.0), f + step, |x| {
+            quick_gain(ctx, c, x, decay)
+        });
+        if let Some(l) = decay {
+            let periods = f / l;
+            let p = golden((periods / 2.0).ln(), (periods * 2.0).ln(), |lp| {
+                quick_gain(ctx, c, f, Some(f / lp.exp()))
+            })
+            .exp();
+            decay = Some(f / p);
+        }
+        // The frequency's sd from the curvature of the gain (the log likelihood) at its peak.
+        let h = step / 20.0;
+        let curvature = (quick_gain(ctx, c, f + h, decay) - 2.0 * quick_gain(ctx, c, f, decay)
+            + quick_gain(ctx, c, f - h, decay))
+            / (h * h);
+        let frequency_sd = if curvature < 0.0 {
+            1.0 / (-curvature).sqrt()
+        } else {
+            f64::NAN
+        };
+        let b = ctx.projector.residualize(&columns(ctx, c, f, decay));
+        let e = explain(&ctx.y, &b);
+        // Amplitude and phase per column pair count ½·ln N each; the frequency (and decay)
+        // searched on a grid count the logarithm of the grid's points.
+        let penalty = 0.5 * e.rank as f64 * ctx.ln_n + (points as f64).ln();
+        out.push(Oscillation {
+            frequency_hz: f,
+            frequency_sd,
+            decay,
+            scored: Scored::new(e, penalty),
+        });
+    }
+    out
+}
