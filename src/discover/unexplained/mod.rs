@@ -27,6 +27,7 @@
 
 mod oscillation;
 mod regression;
+mod timing;
 
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
@@ -41,6 +42,7 @@ use super::fits::MISMATCH_MIN_SHARE;
 use super::settings::EVIDENCE_THRESHOLD;
 use oscillation::Oscillation;
 use regression::{Explained, Projector, explain};
+use timing::FinePrediction;
 
 /// Input steps (besides the record's start) a ringing oscillation is fitted after at most: the
 /// largest ones; a long real record's many small steps ring too little to matter.
@@ -71,14 +73,14 @@ pub struct Context {
     pub n: usize,
     pub channels: Vec<String>,
     pub sigma: Vec<f64>,
-    /// Each channel's prediction (observed − residual), in its own unit.
-    pub prediction: Vec<Vec<f64>>,
     pub y: DVector<f64>,
     /// y with the part the model's parameters can still take removed.
     pub y_perp: DVector<f64>,
     pub projector: Projector,
     /// The record's start and its largest input steps [s].
     pub steps: Vec<f64>,
+    /// The prediction on a grid ten times finer, from t = 0.
+    pub fine: FinePrediction,
     pub ln_n: f64,
 }
 
@@ -105,7 +107,6 @@ impl Context {
         let mut y = DVector::zeros(m);
         let mut j = DMatrix::zeros(m, forward.n_calibrated());
         let mut sigma = Vec::new();
-        let mut prediction = Vec::new();
         for (c, name) in names.iter().enumerate() {
             let s = x[posterior.log_sigma_index(record, c)].exp();
             let k = forward
@@ -113,7 +114,6 @@ impl Context {
                 .iter()
                 .position(|f| f == name)
                 .ok_or_else(|| Error::Numerical(format!("channel {name} is not simulated")))?;
-            let observed = posterior.observed(record, c);
             for i in 0..n {
                 y[c * n + i] = residuals[c][i] / s;
                 for p in 0..forward.n_calibrated() {
@@ -121,8 +121,8 @@ impl Context {
                 }
             }
             sigma.push(s);
-            prediction.push((0..n).map(|i| observed[i] - residuals[c][i]).collect());
         }
+        let fine = FinePrediction::of(&forward, &theta, &names)?;
         let projector = Projector::new(j);
         let y_perp = DVector::from_column_slice(
             projector
@@ -146,11 +146,11 @@ impl Context {
             n,
             channels: names,
             sigma,
-            prediction,
             y,
             y_perp,
             projector,
             steps,
+            fine,
             ln_n: (problem.n_observations() as f64).ln(),
         })
     }
@@ -169,14 +169,15 @@ impl Context {
         b
     }
 
-    /// dŷ/dt of channel c (central differences on the sample grid), whitened.
+    /// dŷ/dt of channel c (central differences on the fine grid), whitened.
     fn derivative(&self, c: usize) -> Vec<f64> {
-        let (t, y) = (&self.times, &self.prediction[c]);
-        let n = self.n;
-        (0..n)
-            .map(|i| {
-                let (a, b) = (i.saturating_sub(1), (i + 1).min(n - 1));
-                (y[b] - y[a]) / (t[b] - t[a]) / self.sigma[c]
+        let y = &self.fine.channels[c];
+        let h = self.fine.times[1] - self.fine.times[0];
+        self.times
+            .iter()
+            .map(|&t| {
+                let k = ((t / h).round() as usize).clamp(1, y.len() - 2);
+                (y[k + 1] - y[k - 1]) / (2.0 * h) / self.sigma[c]
             })
             .collect()
     }
@@ -232,6 +233,19 @@ impl Fingerprint {
             | Fingerprint::Delay { score, .. }
             | Fingerprint::Lag { score, .. }
             | Fingerprint::Unknown { score } => *score,
+        }
+    }
+
+    /// The kind, with the channel and whether it rings: two fingerprints with the same
+    /// identity are two estimates of one thing.
+    fn identity(&self) -> String {
+        match self {
+            Fingerprint::Oscillation {
+                channel, ringing, ..
+            } => format!("oscillation/{channel}/{ringing}"),
+            Fingerprint::Delay { .. } => "delay".into(),
+            Fingerprint::Lag { channel, .. } => format!("lag/{channel}"),
+            Fingerprint::Unknown { .. } => "unknown".into(),
         }
     }
 
@@ -335,16 +349,18 @@ fn scores(ctx: &Context, shift: f64) -> Scores {
         for o in oscillation::search(ctx, c) {
             fingerprints.push(oscillation_fingerprint(&o, &name, shift));
         }
-        // A lag: y_measured ≈ ŷ − τ·dŷ/dt on this channel alone (τ > 0).
+        // A lag: y_measured ≈ ŷ − τ·dŷ/dt on this channel alone (τ > 0), then fitted exactly.
         let d = DMatrix::from_column_slice(n, 1, &ctx.derivative(c));
         let s = ctx.score(&ctx.in_channel(c, &d), 0.0);
         if s.explained.coefficients[0] < 0.0 {
-            fingerprints.push(Fingerprint::Lag {
-                channel: name,
-                seconds: -s.explained.coefficients[0],
-                sd: s.explained.sd[0],
-                score: s.score - shift,
-            });
+            if let Some(t) = timing::fit(ctx, &ctx.fine, Some(c), -s.explained.coefficients[0]) {
+                fingerprints.push(Fingerprint::Lag {
+                    channel: name,
+                    seconds: t.tau,
+                    sd: t.sd,
+                    score: t.gain - 0.5 * ctx.ln_n - shift,
+                });
+            }
         }
     }
     // A delay: every channel late by the same τ.
@@ -356,11 +372,13 @@ fn scores(ctx: &Context, shift: f64) -> Scores {
     }
     let s = ctx.score(&d, 0.0);
     if s.explained.coefficients[0] < 0.0 && ctx.channels.len() > 1 {
-        fingerprints.push(Fingerprint::Delay {
-            seconds: -s.explained.coefficients[0],
-            sd: s.explained.sd[0],
-            score: s.score - shift,
-        });
+        if let Some(t) = timing::fit(ctx, &ctx.fine, None, -s.explained.coefficients[0]) {
+            fingerprints.push(Fingerprint::Delay {
+                seconds: t.tau,
+                sd: t.sd,
+                score: t.gain - 0.5 * ctx.ln_n - shift,
+            });
+        }
     }
     for g in &mut generic {
         g.scored.score -= shift;
@@ -446,6 +464,15 @@ pub fn unexplained(
         });
     }
     candidates.sort_by(|a, b| b.score().total_cmp(&a.score()));
+    // One of each kind (per channel, and ringing or not): the best, whichever model it was
+    // scored on.
+    let mut seen = Vec::new();
+    candidates.retain(|f| {
+        let key = f.identity();
+        let fresh = !seen.contains(&key);
+        seen.push(key);
+        fresh
+    });
     let evidence = candidates
         .iter()
         .map(Fingerprint::score)

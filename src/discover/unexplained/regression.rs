@@ -63,9 +63,8 @@ pub struct Explained {
     pub gain: f64,
     /// rank(B̃): the degrees of freedom it spends.
     pub rank: usize,
-    /// The coefficients of B's columns and their standard deviations (σ = 1 in whitened units).
+    /// The coefficients of B's columns (σ = 1 in whitened units).
     pub coefficients: Vec<f64>,
-    pub sd: Vec<f64>,
     /// B̃·coefficients: the part of y it explains.
     pub fitted: DVector<f64>,
     /// The pointwise sd of `fitted`.
@@ -95,9 +94,6 @@ pub fn explain(y: &DVector<f64>, b_tilde: &DMatrix<f64>) -> Explained {
         gain,
         rank,
         coefficients: beta.iter().copied().collect(),
-        sd: (0..beta.len())
-            .map(|k| g_inv[(k, k)].max(0.0).sqrt())
-            .collect(),
         fitted,
         fitted_sd,
     }
