@@ -198,8 +198,55 @@ fn write_figures(
         crate::plot::missing_torque(&path, &plot).map_err(|e| AppError::Output(e.to_string()))?;
         outputs.push(path.display().to_string());
     }
+    if let Some(u) = &diagnosis.unexplained {
+        let path = out.join("unexplained.png");
+        crate::plot::unexplained(&path, &unexplained_plot(u))
+            .map_err(|e| AppError::Output(e.to_string()))?;
+        outputs.push(path.display().to_string());
+    }
     diagnosis.outputs.extend(outputs);
     Ok(())
+}
+
+/// The verdict's evidence as figure rows: each channel's residual with what the leading
+/// fingerprint explains of it, then each channel's spectrum of gains.
+fn unexplained_plot(u: &crate::discover::Unexplained) -> crate::plot::UnexplainedPlot {
+    let f = &u.figure;
+    let n = f.times.len();
+    let lead = serde_json::to_value(&u.fingerprint)
+        .ok()
+        .and_then(|v| v["kind"].as_str().map(String::from))
+        .unwrap_or_default();
+    let mut rows = Vec::new();
+    for (c, name) in f.channels.iter().enumerate() {
+        rows.push(crate::plot::UnexplainedRow {
+            x_desc: "t [s]".into(),
+            y_desc: format!("{name} residual [σ]"),
+            x: f.times.clone(),
+            points: f.residual[c * n..(c + 1) * n].to_vec(),
+            points_label: "residual of the selected model".into(),
+            curve: f.explained[c * n..(c + 1) * n].to_vec(),
+            curve_label: format!("what the fingerprint ({lead}) explains"),
+        });
+    }
+    for (name, (freq, gain)) in f.channels.iter().zip(&f.spectrum) {
+        rows.push(crate::plot::UnexplainedRow {
+            x_desc: "frequency [Hz]".into(),
+            y_desc: format!("{name}: gain [nats]"),
+            x: freq.clone(),
+            points: Vec::new(),
+            points_label: String::new(),
+            curve: gain.clone(),
+            curve_label: "a sinusoid through the record".into(),
+        });
+    }
+    crate::plot::UnexplainedPlot {
+        title: format!(
+            "left unexplained: {lead} ({:+.1} nats over the selected model)",
+            u.evidence
+        ),
+        rows,
+    }
 }
 
 fn unit_of(name: &str) -> &'static str {

@@ -73,7 +73,7 @@ pub use settings::{
     LAPLACE_DRAWS, MAX_TERMS, METRIC_ADAPTATION, MIN_SAMPLES, candidate_names, uses_laplace,
 };
 pub use state::{StateFingerprint, records_reverse};
-pub use unexplained::{Fingerprint, Span, Unexplained};
+pub use unexplained::{Fingerprint, Span, Unexplained, UnexplainedFigure};
 
 use crate::bayes::ModelSettings;
 use crate::error::Error;

@@ -20,6 +20,7 @@ mod predictive;
 #[cfg(test)]
 mod tests;
 mod traces;
+mod unexplained;
 
 use std::fmt;
 
@@ -32,6 +33,7 @@ pub use k_study::{KSeries, k_study};
 pub use missing_torque::{MissingTorqueCurve, MissingTorquePlot, missing_torque};
 pub use predictive::{ChannelPrediction, PredictivePlot, posterior_predictive};
 pub use traces::{TraceSeries, traces};
+pub use unexplained::{UnexplainedPlot, UnexplainedRow, unexplained};
 
 /// Error of a plotting function: a human-readable message.
 #[derive(Debug, Clone, PartialEq, Eq)]

@@ -306,12 +306,38 @@ pub struct Unexplained {
     pub fingerprint: Fingerprint,
     pub alternatives: Vec<Fingerprint>,
     pub suggestion: String,
+    /// The evidence behind the fingerprint, for the command's figure.
+    #[serde(skip)]
+    pub figure: UnexplainedFigure,
+}
+
+/// What `unexplained.png` shows: each channel's whitened residual with the part the leading
+/// fingerprint explains, and each channel's spectrum of gains (the sinusoid's log-likelihood
+/// gain at each searched frequency).
+#[derive(Clone, Debug, Default)]
+pub struct UnexplainedFigure {
+    pub times: Vec<f64>,
+    pub channels: Vec<String>,
+    /// Stacked channel after channel, in noise σ.
+    pub residual: Vec<f64>,
+    pub explained: Vec<f64>,
+    /// Per channel: (frequencies [Hz], gains [nats]).
+    pub spectrum: Vec<(Vec<f64>, Vec<f64>)>,
 }
 
 /// Everything scored on one model's residuals: the fingerprints and the generic alternatives.
 struct Scores {
-    fingerprints: Vec<Fingerprint>,
+    fingerprints: Vec<Evidence>,
     generic: Vec<Generic>,
+}
+
+/// A fingerprint with what it explains, and of which residual (whitened, stacked), for the
+/// figure.
+#[derive(Clone)]
+struct Evidence {
+    fingerprint: Fingerprint,
+    residual: Vec<f64>,
+    explained: Vec<f64>,
 }
 
 fn scores(ctx: &Context, shift: f64) -> Scores {
@@ -347,18 +373,26 @@ fn scores(ctx: &Context, shift: f64) -> Scores {
             });
         }
         for o in oscillation::search(ctx, c) {
-            fingerprints.push(oscillation_fingerprint(&o, &name, shift));
+            fingerprints.push(Evidence {
+                fingerprint: oscillation_fingerprint(&o, &name, shift),
+                residual: ctx.y.as_slice().to_vec(),
+                explained: o.scored.explained.fitted.as_slice().to_vec(),
+            });
         }
         // A lag: y_measured ≈ ŷ − τ·dŷ/dt on this channel alone (τ > 0), then fitted exactly.
         let d = DMatrix::from_column_slice(n, 1, &ctx.derivative(c));
         let s = ctx.score(&ctx.in_channel(c, &d), 0.0);
         if s.explained.coefficients[0] < 0.0 {
             if let Some(t) = timing::fit(ctx, &ctx.fine, Some(c), -s.explained.coefficients[0]) {
-                fingerprints.push(Fingerprint::Lag {
-                    channel: name,
-                    seconds: t.tau,
-                    sd: t.sd,
-                    score: t.gain - 0.5 * ctx.ln_n - shift,
+                fingerprints.push(Evidence {
+                    fingerprint: Fingerprint::Lag {
+                        channel: name,
+                        seconds: t.tau,
+                        sd: t.sd,
+                        score: t.gain - 0.5 * ctx.ln_n - shift,
+                    },
+                    residual: ctx.y.as_slice().to_vec(),
+                    explained: t.change,
                 });
             }
         }
@@ -373,10 +407,14 @@ fn scores(ctx: &Context, shift: f64) -> Scores {
     let s = ctx.score(&d, 0.0);
     if s.explained.coefficients[0] < 0.0 && ctx.channels.len() > 1 {
         if let Some(t) = timing::fit(ctx, &ctx.fine, None, -s.explained.coefficients[0]) {
-            fingerprints.push(Fingerprint::Delay {
-                seconds: t.tau,
-                sd: t.sd,
-                score: t.gain - 0.5 * ctx.ln_n - shift,
+            fingerprints.push(Evidence {
+                fingerprint: Fingerprint::Delay {
+                    seconds: t.tau,
+                    sd: t.sd,
+                    score: t.gain - 0.5 * ctx.ln_n - shift,
+                },
+                residual: ctx.y.as_slice().to_vec(),
+                explained: t.change,
             });
         }
     }
@@ -457,38 +495,50 @@ pub fn unexplained(
         .generic
         .iter()
         .max_by(|a, b| a.scored.score.total_cmp(&b.scored.score));
-    let mut candidates: Vec<Fingerprint> = all.fingerprints;
+    let mut candidates: Vec<Evidence> = all.fingerprints;
     if let Some(g) = best_generic {
-        candidates.push(Fingerprint::Unknown {
-            score: g.scored.score - EVIDENCE_THRESHOLD,
+        candidates.push(Evidence {
+            fingerprint: Fingerprint::Unknown {
+                score: g.scored.score - EVIDENCE_THRESHOLD,
+            },
+            residual: ctx.y.as_slice().to_vec(),
+            explained: g.scored.explained.fitted.as_slice().to_vec(),
         });
     }
-    candidates.sort_by(|a, b| b.score().total_cmp(&a.score()));
+    candidates.sort_by(|a, b| b.fingerprint.score().total_cmp(&a.fingerprint.score()));
     // One of each kind (per channel, and ringing or not): the best, whichever model it was
     // scored on.
     let mut seen = Vec::new();
-    candidates.retain(|f| {
-        let key = f.identity();
+    candidates.retain(|e| {
+        let key = e.fingerprint.identity();
         let fresh = !seen.contains(&key);
         seen.push(key);
         fresh
     });
     let evidence = candidates
         .iter()
-        .map(Fingerprint::score)
+        .map(|e| e.fingerprint.score())
         .chain(best_generic.map(|g| g.scored.score))
         .fold(f64::NEG_INFINITY, f64::max);
     if !(evidence > EVIDENCE_THRESHOLD) {
         return Ok(None);
     }
-    let lead = candidates[0].score();
-    let fingerprint = candidates[0].clone();
+    let lead = candidates[0].fingerprint.score();
+    let fingerprint = candidates[0].fingerprint.clone();
     let alternatives: Vec<Fingerprint> = candidates[1..]
         .iter()
+        .map(|e| e.fingerprint.clone())
         .filter(|f| f.score() > EVIDENCE_THRESHOLD && lead - f.score() <= EVIDENCE_THRESHOLD)
-        .cloned()
         .collect();
-    // Channels: those whose own best generic alternative clears the threshold.
+    let figure = UnexplainedFigure {
+        times: ctx.times.clone(),
+        channels: ctx.channels.clone(),
+        residual: candidates[0].residual.clone(),
+        explained: candidates[0].explained.clone(),
+        spectrum: (0..ctx.channels.len())
+            .map(|c| oscillation::spectrum(&ctx, c))
+            .collect(),
+    };
     let mut channels = Vec::new();
     let mut where_ = Vec::new();
     for c in 0..ctx.channels.len() {
@@ -520,5 +570,6 @@ pub fn unexplained(
         fingerprint,
         alternatives,
         suggestion,
+        figure,
     }))
 }

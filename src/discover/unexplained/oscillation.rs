@@ -112,18 +112,31 @@ fn golden(lo: f64, hi: f64, mut g: impl FnMut(f64) -> f64) -> f64 {
     (a + b) / 2.0
 }
 
-/// The best oscillation of each kind (running on, ringing) in channel c.
-pub fn search(ctx: &Context, c: usize) -> Vec<Oscillation> {
+/// The searched frequencies and their spacing.
+fn frequency_grid(ctx: &Context) -> (Vec<f64>, f64, f64) {
     let span = ctx.times[ctx.n - 1] - ctx.times[0];
     let dt = span / (ctx.n - 1).max(1) as f64;
     let nyquist = 0.5 / dt;
     // Below two periods over the record an oscillation is a trend (the polynomial's).
     let f_min = 2.0 / span;
     let step = (1.0 / (OVERSAMPLING * span)).max((nyquist - f_min) / MAX_FREQUENCIES as f64);
-    let grid: Vec<f64> = (0..)
+    let grid = (0..)
         .map(|k| f_min + k as f64 * step)
         .take_while(|&f| f < nyquist)
         .collect();
+    (grid, step, f_min)
+}
+
+/// The gain of a sinusoid running through the record at each searched frequency (channel c).
+pub fn spectrum(ctx: &Context, c: usize) -> (Vec<f64>, Vec<f64>) {
+    let (grid, _, _) = frequency_grid(ctx);
+    let gains = grid.iter().map(|&f| quick_gain(ctx, c, f, None)).collect();
+    (grid, gains)
+}
+
+/// The best oscillation of each kind (running on, ringing) in channel c.
+pub fn search(ctx: &Context, c: usize) -> Vec<Oscillation> {
+    let (grid, step, f_min) = frequency_grid(ctx);
     if grid.is_empty() {
         return Vec::new();
     }

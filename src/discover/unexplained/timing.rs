@@ -116,6 +116,8 @@ fn gain(ctx: &Context, d: &DMatrix<f64>) -> f64 {
 /// A fitted timing hypothesis.
 pub struct Timing {
     pub tau: f64,
+    /// What it changes in the stacked whitened output, the model's parameters refitted.
+    pub change: Vec<f64>,
     /// From the curvature of the gain (the log likelihood) at τ.
     pub sd: f64,
     pub gain: f64,
@@ -158,8 +160,14 @@ pub fn fit(
     } else {
         f64::NAN
     };
+    let change = ctx
+        .projector
+        .residualize(&change(ctx, fine, channel, tau))
+        .as_slice()
+        .to_vec();
     (best > 0.0).then_some(Timing {
         tau,
+        change,
         sd,
         gain: best,
     })
