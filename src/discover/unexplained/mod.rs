@@ -25,6 +25,7 @@
 //! than the threshold: then the kind is `unknown`. Others within the threshold of the leader
 //! are listed as alternatives.
 
+mod fingerprint;
 mod oscillation;
 mod regression;
 mod timing;
@@ -40,6 +41,7 @@ use super::candidate::Candidate;
 use super::coincide::input_steps;
 use super::fits::MISMATCH_MIN_SHARE;
 use super::settings::EVIDENCE_THRESHOLD;
+pub use fingerprint::Fingerprint;
 use oscillation::Oscillation;
 use regression::{Explained, Projector, explain};
 use timing::FinePrediction;
@@ -196,103 +198,6 @@ pub struct Span {
     pub channel: String,
     pub t_start: f64,
     pub t_end: f64,
-}
-
-/// The leading kinds of structure left, each with its own score (nats over the model).
-#[derive(Clone, Debug, Serialize)]
-#[serde(tag = "kind", rename_all = "snake_case")]
-pub enum Fingerprint {
-    Oscillation {
-        frequency_hz: f64,
-        frequency_sd: f64,
-        damping_ratio: Option<f64>,
-        channel: String,
-        ringing: bool,
-        score: f64,
-    },
-    Delay {
-        seconds: f64,
-        sd: f64,
-        score: f64,
-    },
-    Lag {
-        channel: String,
-        seconds: f64,
-        sd: f64,
-        score: f64,
-    },
-    Unknown {
-        score: f64,
-    },
-}
-
-impl Fingerprint {
-    pub fn score(&self) -> f64 {
-        match self {
-            Fingerprint::Oscillation { score, .. }
-            | Fingerprint::Delay { score, .. }
-            | Fingerprint::Lag { score, .. }
-            | Fingerprint::Unknown { score } => *score,
-        }
-    }
-
-    /// The kind, with the channel and whether it rings: two fingerprints with the same
-    /// identity are two estimates of one thing.
-    fn identity(&self) -> String {
-        match self {
-            Fingerprint::Oscillation {
-                channel, ringing, ..
-            } => format!("oscillation/{channel}/{ringing}"),
-            Fingerprint::Delay { .. } => "delay".into(),
-            Fingerprint::Lag { channel, .. } => format!("lag/{channel}"),
-            Fingerprint::Unknown { .. } => "unknown".into(),
-        }
-    }
-
-    /// What a user might do about it, in a sentence.
-    pub fn suggestion(&self, channels: &[String]) -> String {
-        match self {
-            Fingerprint::Oscillation {
-                frequency_hz,
-                damping_ratio,
-                channel,
-                ringing: true,
-                ..
-            } => format!(
-                "a resonance at {frequency_hz:.1} Hz (damping ratio {:.3}) rings on {channel} \
-                 after the input steps: a compliant coupling to the load (the term \
-                 compliant_coupling) or a resonant sensor; a record with sharper steps, or \
-                 with the load decoupled, would tell them apart",
-                damping_ratio.unwrap_or(f64::NAN)
-            ),
-            Fingerprint::Oscillation {
-                frequency_hz,
-                channel,
-                ..
-            } => format!(
-                "a periodic disturbance at {frequency_hz:.1} Hz runs on {channel} regardless \
-                 of the input: a pulsing load, an eccentric or cogging (compare it with the \
-                 turning frequency ω/2π), or interference on the sensor"
-            ),
-            Fingerprint::Delay { seconds, .. } => format!(
-                "every channel is late by {:.3} ms: the input acts later than modelled (the \
-                 term input_delay)",
-                seconds * 1e3
-            ),
-            Fingerprint::Lag {
-                channel, seconds, ..
-            } => format!(
-                "{channel} lags the model with a time constant of {:.3} ms: a filter in its \
-                 sensor or logger (the term sensor_lag on {channel})",
-                seconds * 1e3
-            ),
-            Fingerprint::Unknown { .. } => format!(
-                "structure no library term holds remains in {}: a record with another input \
-                 (a reversal, steps of several sizes) would show how it depends on the state",
-                channels.join(" and ")
-            ),
-        }
-    }
 }
 
 /// The verdict's report: `null` in the JSON when nothing is left.
@@ -499,13 +404,19 @@ pub fn unexplained(
     if let Some(g) = best_generic {
         candidates.push(Evidence {
             fingerprint: Fingerprint::Unknown {
-                score: g.scored.score - EVIDENCE_THRESHOLD,
+                score: g.scored.score,
             },
             residual: ctx.y.as_slice().to_vec(),
             explained: g.scored.explained.fitted.as_slice().to_vec(),
         });
     }
-    candidates.sort_by(|a, b| b.fingerprint.score().total_cmp(&a.fingerprint.score()));
+    // A generic alternative leads only when it beats every specific one by more than the
+    // threshold: it can hold anything, so it must buy its generality.
+    let rank = |f: &Fingerprint| match f {
+        Fingerprint::Unknown { score } => score - EVIDENCE_THRESHOLD,
+        other => other.score(),
+    };
+    candidates.sort_by(|a, b| rank(&b.fingerprint).total_cmp(&rank(&a.fingerprint)));
     // One of each kind (per channel, and ringing or not): the best, whichever model it was
     // scored on.
     let mut seen = Vec::new();
@@ -523,12 +434,22 @@ pub fn unexplained(
     if !(evidence > EVIDENCE_THRESHOLD) {
         return Ok(None);
     }
-    let lead = candidates[0].fingerprint.score();
+    // A specific kind leads only where it clears the threshold itself; otherwise what is left
+    // is `unknown` (the generic alternatives' evidence).
+    let eligible = |e: &Evidence| {
+        matches!(e.fingerprint, Fingerprint::Unknown { .. })
+            || e.fingerprint.score() > EVIDENCE_THRESHOLD
+    };
+    candidates.retain(eligible);
+    if candidates.is_empty() {
+        return Ok(None);
+    }
+    let lead = rank(&candidates[0].fingerprint);
     let fingerprint = candidates[0].fingerprint.clone();
     let alternatives: Vec<Fingerprint> = candidates[1..]
         .iter()
         .map(|e| e.fingerprint.clone())
-        .filter(|f| f.score() > EVIDENCE_THRESHOLD && lead - f.score() <= EVIDENCE_THRESHOLD)
+        .filter(|f| f.score() > EVIDENCE_THRESHOLD && lead - rank(f) <= EVIDENCE_THRESHOLD)
         .collect();
     let figure = UnexplainedFigure {
         times: ctx.times.clone(),

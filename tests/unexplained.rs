@@ -1,0 +1,146 @@
+//! The third verdict: when no term of the library holds what the recording shows, `discover`
+//! says so and fingerprints it, instead of "nothing missing found"; where nothing is missing it
+//! stays silent.
+//!
+//! The three effects were simulated outside the crate's model, by the independent fixed-step
+//! Runge–Kutta integrator of `examples/beyond_library_cases.rs` (seeds 510007, 510008, 510018,
+//! the answer beside each recording):
+//!
+//! ```text
+//! cargo run --release --example beyond_library_cases -- --out /tmp/bl --per-effect 2
+//! ```
+//!
+//! They are asked of the thirteen terms the library had before it gained `input_delay`,
+//! `sensor_lag` and `compliant_coupling`: "beyond the library" means beyond the candidates the
+//! diagnosis is given. Rank-only, a few seconds a case.
+
+use std::path::{Path, PathBuf};
+
+use motorcal::discover::{DiscoverSettings, Fingerprint, Unexplained, discover};
+use motorcal::study::cases::{CaseOptions, make_case};
+use motorcal::study::{InputProfile, Problem};
+
+const THIRTEEN: [&str; 13] = [
+    "torque_constant",
+    "back_emf_constant",
+    "viscous_friction",
+    "coulomb_friction",
+    "asymmetric_friction",
+    "quadratic_drag",
+    "load_torque",
+    "load_step",
+    "voltage_drop",
+    "resistance_heating",
+    "armature_reaction",
+    "current_offset",
+    "speed_gain",
+];
+
+fn settings() -> DiscoverSettings {
+    let mut s = DiscoverSettings {
+        rank_only: true,
+        candidates: Some(THIRTEEN.iter().map(|s| s.to_string()).collect()),
+        ..DiscoverSettings::default()
+    };
+    s.run.quiet = true;
+    s
+}
+
+fn fixture(name: &str) -> (Problem, serde_json::Value) {
+    let dir: PathBuf = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fixtures/beyond")
+        .join(name);
+    let problem =
+        Problem::from_files(&[dir.join("recording.csv")], &dir.join("motor.toml")).unwrap();
+    let answer =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("answer.json")).unwrap()).unwrap();
+    (problem, answer)
+}
+
+fn verdict(problem: &Problem) -> Option<Unexplained> {
+    let d = discover(problem, &settings()).unwrap();
+    eprintln!(
+        "selected {:?}; unexplained {}",
+        d.selected_set,
+        serde_json::to_string(&d.unexplained).unwrap()
+    );
+    assert_eq!(d.residual_mismatch, d.unexplained.is_some());
+    d.unexplained
+}
+
+fn within(estimate: f64, truth: f64, share: f64) -> bool {
+    (estimate / truth - 1.0).abs() <= share
+}
+
+#[test]
+fn a_resonance_of_the_load_is_named_by_its_frequency_and_it_rings() {
+    let (problem, answer) = fixture("compliant_coupling-510018");
+    let truth = answer["fingerprint"]["frequency_hz"].as_f64().unwrap();
+    let u = verdict(&problem).expect("a resonance 235 nats strong is not 'nothing missing'");
+    match u.fingerprint {
+        Fingerprint::Oscillation {
+            frequency_hz,
+            ringing,
+            ref channel,
+            ..
+        } => {
+            assert!(
+                within(frequency_hz, truth, 0.15),
+                "{frequency_hz} Hz vs {truth}"
+            );
+            assert!(ringing, "a resonance rings after the steps");
+            assert_eq!(channel, "omega");
+        }
+        other => panic!("expected an oscillation, found {other:?}"),
+    }
+}
+
+#[test]
+fn a_late_input_is_named_a_delay_within_thirty_percent() {
+    let (problem, answer) = fixture("input_delay-510007");
+    let truth = answer["fingerprint"]["seconds"].as_f64().unwrap();
+    match verdict(&problem).expect("a delay").fingerprint {
+        Fingerprint::Delay { seconds, .. } => {
+            assert!(within(seconds, truth, 0.3), "{seconds} s vs {truth}")
+        }
+        other => panic!("expected a delay, found {other:?}"),
+    }
+}
+
+#[test]
+fn a_filtered_sensor_is_named_a_lag_on_its_channel() {
+    let (problem, answer) = fixture("sensor_lag-510008");
+    let truth = answer["fingerprint"]["seconds"].as_f64().unwrap();
+    let channel_truth = answer["fingerprint"]["channel"].as_str().unwrap();
+    match verdict(&problem).expect("a lag").fingerprint {
+        Fingerprint::Lag {
+            seconds, channel, ..
+        } => {
+            assert_eq!(channel, channel_truth);
+            assert!(within(seconds, truth, 0.3), "{seconds} s vs {truth}");
+        }
+        other => panic!("expected a lag, found {other:?}"),
+    }
+}
+
+/// Null cases of the crate's own generator: nothing missing, and nothing said to be.
+#[test]
+fn a_recording_of_the_model_itself_leaves_nothing_unexplained() {
+    for (seed, input) in [(2, InputProfile::Constant), (3, InputProfile::Reversal)] {
+        let case = make_case(&CaseOptions {
+            effects: vec!["none".into()],
+            magnitude: None,
+            input,
+            seed,
+            conceal: true,
+        })
+        .unwrap();
+        let problem = Problem {
+            label: "null".into(),
+            recordings: vec![case.recording],
+            model: case.nominal,
+            reference: None,
+        };
+        assert!(verdict(&problem).is_none(), "seed {seed}");
+    }
+}
