@@ -1,0 +1,44 @@
+#!/usr/bin/env python3
+"""The verdict on each beyond-library case against its truth, as a Markdown table and a tally."""
+import json, os, sys
+
+d = sys.argv[1]
+rows, tally = [], {}
+for c in sorted(os.listdir(d)):
+    p = os.path.join(d, c)
+    if not os.path.exists(f"{p}/report.json"):
+        continue
+    a = json.load(open(f"{p}/answer.json")); r = json.load(open(f"{p}/report.json"))
+    u = r.get("unexplained"); truth = a["fingerprint"]
+    fp = u["fingerprint"] if u else None
+    def show(f):
+        if not f: return "—"
+        k = f["kind"]
+        if k == "oscillation":
+            z = f.get("damping_ratio")
+            return f"oscillation {f['frequency_hz']:.1f} Hz on {f['channel']}, {'rings' if f['ringing'] else 'runs on'}" + (f", ζ {z:.3f}" if z is not None else "")
+        if k == "delay": return f"delay {f['seconds']*1e3:.3f} ms"
+        if k == "lag": return f"lag on {f['channel']} {f['seconds']*1e3:.3f} ms"
+        return k
+    def show_truth(t):
+        k = t["kind"]
+        if k == "oscillation": return f"oscillation {t['frequency_hz']:.1f} Hz ({'rings' if t['ringing'] else 'runs on'})"
+        if k in ("delay", "lag"): return f"{k}{' on '+t['channel'] if k=='lag' else ''} {t['seconds']*1e3:.3f} ms"
+        if k == "state": return f"state: {', '.join(t['functions'])}"
+        return f"{k}: {t.get('variable','')}"
+    kind_right = bool(fp) and fp["kind"] == truth["kind"]
+    said_nothing = not u and not r["selected_set"]
+    library_alone = not u and bool(r["selected_set"])
+    key = a["effect"]
+    t = tally.setdefault(key, [0, 0, 0, 0])
+    t[0] += 1; t[1] += bool(u); t[2] += kind_right; t[3] += library_alone
+    rows.append(f"| {c} | {a['type']} | {a['miss_nats']:.0f} | {show_truth(truth)} | {' + '.join(r['selected_set']) or 'none'} | "
+                f"{'%+.1f' % u['evidence'] if u else 'null'} | {show(fp)} | {'nothing missing found' if said_nothing else ''} |")
+print("| case | type | miss (nats) | truth | selected | unexplained | fingerprint | |")
+print("|---|---|---|---|---|---|---|---|")
+print("\n".join(rows))
+print()
+print("| effect | cases | unexplained not null | kind right | a library term alone, verdict null |")
+print("|---|---|---|---|---|")
+for k, (n, u, kr, lib) in sorted(tally.items()):
+    print(f"| {k} | {n} | {u} | {kr} | {lib} |")
