@@ -5,7 +5,10 @@
 //! confusion tables.
 //!
 //! cargo run --release --example diagnose_study -- [--per-effect 5] [--null 20] [--two 20]
-//!     [--seed-base 900000] [--out papers/diagnose] [--full]
+//!     [--seed-base 900000] [--out papers/diagnose] [--full] [--effects a,b] [--no-dev]
+//!
+//! `--effects` restricts the one-effect cases to the named terms (seeds are then given to those
+//! only, in the library's order); `--no-dev` skips the development set.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -95,13 +98,27 @@ fn main() {
     let seed_base: u64 = arg(&args, "--seed-base", 900_000);
     let out = PathBuf::from(arg(&args, "--out", "papers/diagnose".to_string()));
     let full = args.iter().any(|a| a == "--full");
+    let no_dev = args.iter().any(|a| a == "--no-dev");
+    let only: Option<Vec<String>> = args
+        .iter()
+        .position(|a| a == "--effects")
+        .and_then(|i| args.get(i + 1))
+        .map(|list| list.split(',').map(str::to_string).collect());
+    if let Some(names) = &only
+        && let Some(unknown) = names.iter().find(|n| !Term::NAMES.contains(&n.as_str()))
+    {
+        panic!("--effects: unknown term {unknown}");
+    }
 
     // Case specifications: (set, effects, seed, first input).
     let mut specs: Vec<(String, Vec<String>, u64, InputProfile)> = Vec::new();
     let inputs = [InputProfile::Constant, InputProfile::Reversal];
     let mut seed = seed_base;
     for round in 0..per_effect {
-        for name in Term::NAMES {
+        for name in Term::NAMES
+            .iter()
+            .filter(|n| only.as_ref().is_none_or(|o| o.iter().any(|e| e == *n)))
+        {
             specs.push((
                 "one".into(),
                 vec![name.to_string()],
@@ -217,7 +234,7 @@ fn main() {
     rows.extend(two_rows);
 
     let dev = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/concealed-dev");
-    if dev.is_dir() && !args.iter().any(|a| a == "--skip-dev") {
+    if dev.is_dir() && !no_dev && !args.iter().any(|a| a == "--skip-dev") {
         for i in 1..=14 {
             let dir = dev.join(format!("case{i:02}"));
             let answer: serde_json::Value =

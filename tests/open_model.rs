@@ -57,6 +57,9 @@ fn truth_values(name: &str) -> Vec<f64> {
         "current_offset" => vec![11.0],
         "speed_gain" => vec![0.03],
         "asymmetric_friction" => vec![3e-5],
+        "input_delay" => vec![1e-4],
+        "sensor_lag" => vec![2e-3],
+        "compliant_coupling" => vec![0.3, 60.0, 0.1],
         other => panic!("no truth for {other}"),
     }
 }

@@ -45,6 +45,9 @@ pub fn visible_values(name: &str) -> Vec<f64> {
         "current_offset" => vec![6.0],
         "speed_gain" => vec![0.04],
         "asymmetric_friction" => vec![-2e-5],
+        "input_delay" => vec![2e-4],
+        "sensor_lag" => vec![3e-3],
+        "compliant_coupling" => vec![0.2, 60.0, 0.1],
         other => panic!("no values for {other}"),
     }
 }
@@ -125,10 +128,14 @@ fn all_terms_together_have_exact_sensitivities_simulate_and_fit() {
     let names = calibrated(&model);
     assert_eq!(
         names.len(),
-        15,
-        "R and fourteen term parameters (load_step has two)"
+        20,
+        "R and nineteen term parameters (load_step has two, compliant_coupling three)"
     );
-    assert_eq!(model.n_states(), 3, "I, ω and the heating's energy");
+    assert_eq!(
+        model.n_states(),
+        6,
+        "I, ω, the heating's energy, the coupling's twist and load speed, the lagged sensor"
+    );
     assert_sensitivities_match_finite_differences(model, &names);
 }
 

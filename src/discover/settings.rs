@@ -129,7 +129,8 @@ impl FitStage {
     }
 }
 
-/// The candidates to rank: the given names (checked) or every term the model lacks.
+/// The candidates to rank: the given names (checked) or every screened term the model lacks
+/// (the dynamic ones are fitted where the unexplained verdict names them).
 pub fn candidate_names(problem: &Problem, given: Option<&[String]>) -> Result<Vec<String>, Error> {
     let present = |name: &str| problem.model.terms.iter().any(|t| t.term.name() == name);
     let base = problem.model.base;
@@ -156,9 +157,10 @@ pub fn candidate_names(problem: &Problem, given: Option<&[String]>) -> Result<Ve
                          share a clock"
                             .to_string()
                     } else {
+                        let term = Term::named(n).expect("a known name");
                         format!(
-                            "acts on the electrical equation or the current sensor, which a {} \
-                             model does not have",
+                            "{}, which a {} model does not have",
+                            term.not_on_drives(),
                             base.name()
                         )
                     };
@@ -170,6 +172,7 @@ pub fn candidate_names(problem: &Problem, given: Option<&[String]>) -> Result<Ve
         None => Ok(Term::NAMES
             .iter()
             .filter(|n| !present(n) && applies(n))
+            .filter(|n| Term::named(n).is_some_and(|t| t.screened()))
             .map(|n| n.to_string())
             .collect()),
     }

@@ -83,6 +83,24 @@ pub(super) fn parse_terms(
             let slot = if let Some(i) = params.iter().position(|p| p.key == key) {
                 &mut values[i]
             } else if let Some(i) = settings.iter().position(|s| s.key == key) {
+                let choices = settings[i].choices;
+                if !choices.is_empty() {
+                    let chosen = v
+                        .as_str()
+                        .and_then(|c| choices.iter().position(|k| *k == c));
+                    let Some(index) = chosen else {
+                        let names: Vec<String> =
+                            choices.iter().map(|c| format!("\"{c}\"")).collect();
+                        return Err(error(
+                            file,
+                            locate,
+                            &key_field,
+                            format!("{name}.{key} must be one of {}, not {v}", names.join(", ")),
+                        ));
+                    };
+                    setting_values[i] = index as f64;
+                    continue;
+                }
                 &mut setting_values[i]
             } else {
                 let known: Vec<&str> = params
@@ -367,7 +385,14 @@ pub(super) fn write_tables(
             let _ = writeln!(out, "{} = {}", decl.key, toml_number(*v));
         }
         for (decl, v) in t.term.setting_decls().iter().zip(t.term.settings()) {
-            let _ = writeln!(out, "{} = {}", decl.key, toml_number(v));
+            match decl.choices.get(v as usize) {
+                Some(choice) => {
+                    let _ = writeln!(out, "{} = \"{choice}\"", decl.key);
+                }
+                None => {
+                    let _ = writeln!(out, "{} = {}", decl.key, toml_number(v));
+                }
+            }
         }
     }
     if let Some(entries) = calibrate {

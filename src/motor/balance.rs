@@ -41,6 +41,9 @@ pub struct Site<'a, D> {
     pub segment_start: f64,
     pub current: D,
     pub speed: D,
+    /// The constants as the terms' `adjust` left them (J is the rotor's own inertia when a
+    /// term moves part of it behind a spring).
+    pub coefficients: &'a Coefficients<D>,
     pub params: &'a [D],
     pub states: &'a [D],
 }
@@ -141,6 +144,7 @@ impl MotorModel {
                     segment_start: times[i],
                     current: input[i],
                     speed: speed[i],
+                    coefficients: &c,
                     params: &p[self.param_offsets[k]..self.param_offsets[k + 1]],
                     states: &[],
                 };

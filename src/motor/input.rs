@@ -2,6 +2,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::Scalar;
+
 /// The input voltage: the model's constant `U`, or a recorded series held between samples.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
 pub enum VoltageInput {
@@ -35,6 +37,47 @@ impl VoltageInput {
                 .map(|i| times[i])
                 .collect(),
         }
+    }
+}
+
+/// The input of one solve as a sum of steps, for a term that evaluates it at other times than
+/// the integrator's (a delay): 0 before the first start (the switch-on), then `value(j)` from
+/// `starts[j]` on. The starts are the intervals between the right-hand side's breakpoints, so
+/// some steps may be of zero height.
+pub struct InputSteps<'a, D> {
+    pub starts: &'a [f64],
+    /// The held value on each interval; empty when the input is the constant parameter.
+    pub held: &'a [f64],
+    pub constant: D,
+}
+
+impl<D: Scalar> InputSteps<'_, D> {
+    /// The value held from `starts[j]` on.
+    pub fn value(&self, j: usize) -> D {
+        self.held.get(j).map_or(self.constant, |&u| D::from(u))
+    }
+
+    /// The value held at time t (the value of the interval that begins at or before t), 0
+    /// before the switch-on.
+    pub fn value_at(&self, t: f64) -> D {
+        match self.starts.partition_point(|&s| s <= t) {
+            0 => D::from(0.0),
+            j => self.value(j - 1),
+        }
+    }
+
+    /// The steps strictly after `after` and up to `until`: (time, height).
+    pub fn steps_within(&self, after: f64, until: f64) -> impl Iterator<Item = (f64, D)> + '_ {
+        let first = self.starts.partition_point(|&s| s <= after);
+        let last = self.starts.partition_point(|&s| s <= until);
+        (first..last).map(move |j| {
+            let before = if j == 0 {
+                D::from(0.0)
+            } else {
+                self.value(j - 1)
+            };
+            (self.starts[j], self.value(j) - before)
+        })
     }
 }
 

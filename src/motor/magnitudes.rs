@@ -21,6 +21,10 @@ pub struct Magnitudes {
     pub energy: f64,
     /// Length of the recording [s].
     pub duration: f64,
+    /// The electrical time constant L/R [s]: how fast the current follows the voltage.
+    pub electrical_time: f64,
+    /// The mechanical time constant J·R/(c_g·c_m) [s]: how fast the speed settles.
+    pub mechanical_time: f64,
 }
 
 /// The share of a magnitude one prior standard deviation stands for.
@@ -37,6 +41,9 @@ impl MotorModel {
             let current = sane(drive.input_scale());
             let torque = sane(m.torque_constant * current);
             let speed = sane(drive.speed_scale);
+            // The time the drive's full torque takes to reach the record's largest speed; the
+            // electrical loop is the drive's, faster than anything the record resolves.
+            let mechanical_time = sane(m.inertia * speed / torque);
             return Magnitudes {
                 voltage: 1.0,
                 current,
@@ -44,6 +51,8 @@ impl MotorModel {
                 torque,
                 energy: sane(torque * speed * duration),
                 duration: sane(duration),
+                electrical_time: mechanical_time,
+                mechanical_time,
             };
         }
         let held_max = match &self.input {
@@ -65,6 +74,8 @@ impl MotorModel {
             torque,
             energy: sane(voltage * voltage / m.resistance * time_constant),
             duration: sane(duration),
+            electrical_time: sane(m.inductance / m.resistance),
+            mechanical_time: time_constant,
         }
     }
 

@@ -20,7 +20,7 @@ pub mod terms;
 pub use balance::{Balance, Coefficients, Site, torque_balance, voltage_balance};
 pub use base::{Base, CURRENT_DRIVEN_CHANNELS, MOTOR_CHANNELS, POSITION_LOOP_CHANNELS};
 pub use drive::{DriveSettings, SampledDrive};
-pub use input::VoltageInput;
+pub use input::{InputSteps, VoltageInput};
 pub use magnitudes::{Magnitudes, PRIOR_SHARE};
 pub use parameters::{MotorParam, MotorParameters};
 pub use system::{MotorSystem, PlainMotorSystem, Segments};
@@ -103,9 +103,9 @@ impl MotorModel {
         terms.sort_by_key(|t| t.term.rank());
         if let Some(t) = terms.iter().find(|t| !base.accepts(&t.term)) {
             return Err(format!(
-                "term {} acts on the electrical equation or the current sensor, which a {} \
-                 model does not have",
+                "term {} {}, which a {} model does not have",
                 t.term.name(),
+                t.term.not_on_drives(),
                 base.name()
             ));
         }
@@ -241,9 +241,20 @@ impl MotorModel {
     pub fn initial_state<D: Scalar>(&self, p: &[D], y0: &mut [D]) {
         y0[0] = p[MotorParam::InitialCurrent as usize];
         y0[1] = p[MotorParam::InitialSpeed as usize];
+        let n_base = self.base.state_names().len();
         for (k, t) in self.terms.iter().enumerate() {
+            let states = self.state_offsets[k]..self.state_offsets[k + 1];
             for (j, s) in t.term.states().iter().enumerate() {
-                y0[self.state_offsets[k] + j] = D::from(s.initial);
+                y0[states.start + j] = D::from(s.initial);
+            }
+            if !states.is_empty() {
+                let (base, rest) = y0.split_at_mut(n_base);
+                let params = &p[self.param_offsets[k]..self.param_offsets[k + 1]];
+                t.term.initial(
+                    params,
+                    base,
+                    &mut rest[states.start - n_base..states.end - n_base],
+                );
             }
         }
     }
@@ -265,13 +276,14 @@ impl MotorModel {
             return;
         }
         let mut measured = vec![D::from(0.0); n_channels];
-        for i in 0..samples {
+        for (i, y) in states.chunks_exact(n).enumerate() {
             for c in 0..n_channels {
                 measured[c] = out[c * samples + i];
             }
             for (k, t) in self.terms.iter().enumerate() {
                 t.term.measure(
                     &p[self.param_offsets[k]..self.param_offsets[k + 1]],
+                    &y[self.state_offsets[k]..self.state_offsets[k + 1]],
                     &mut measured,
                 );
             }

@@ -2,7 +2,7 @@
 //! side's jumps with the voltage held on each, and the system at one parameter vector.
 
 use super::balance::{Site, torque_balance, voltage_balance};
-use super::{Coefficients, MotorModel, MotorParam, Scalar, VoltageInput};
+use super::{Coefficients, InputSteps, MotorModel, MotorParam, Scalar, VoltageInput};
 use crate::ode::OdeSystem;
 
 impl MotorModel {
@@ -33,6 +33,9 @@ impl MotorModel {
         };
         Segments {
             start: t0,
+            starts: std::iter::once(t0)
+                .chain(breakpoints.iter().copied())
+                .collect(),
             breakpoints,
             voltage,
         }
@@ -44,6 +47,8 @@ impl MotorModel {
 pub struct Segments {
     /// Where the integration starts.
     pub start: f64,
+    /// Where each interval starts: `start`, then the breakpoints.
+    pub starts: Vec<f64>,
     pub breakpoints: Vec<f64>,
     /// The held voltage on each interval; empty when the voltage is the constant parameter `U`.
     pub voltage: Vec<f64>,
@@ -59,20 +64,27 @@ pub struct MotorSystem<'a, D> {
 
 impl<D: Scalar> MotorSystem<'_, D> {
     /// Equations (3)–(4) with every term's contribution.
-    fn with_terms(&self, t: f64, segment: usize, voltage: D, y: &[D], dy: &mut [D]) {
+    fn with_terms(&self, t: f64, segment: usize, mut voltage: D, y: &[D], dy: &mut [D]) {
         let model = self.model;
         let c = &self.coefficients;
         let (current, speed) = (y[0], y[1]);
-        let segment_start = match segment {
-            0 => self.segments.start,
-            s => self.segments.breakpoints[s - 1],
+        let segment_start = self.segments.starts[segment];
+        let params = |k: usize| &self.p[model.param_offsets[k]..model.param_offsets[k + 1]];
+        let input = InputSteps {
+            starts: &self.segments.starts,
+            held: &self.segments.voltage,
+            constant: self.p[MotorParam::Voltage as usize],
         };
+        for (k, active) in model.terms.iter().enumerate() {
+            active.term.input(params(k), t, &input, &mut voltage);
+        }
         let site = |k: usize| Site {
             t,
             segment_start,
             current,
             speed,
-            params: &self.p[model.param_offsets[k]..model.param_offsets[k + 1]],
+            coefficients: c,
+            params: params(k),
             states: &y[model.state_offsets[k]..model.state_offsets[k + 1]],
         };
         let balance = model.balance(c, &site);

@@ -17,13 +17,17 @@ pub enum InputProfile {
     /// U, then U/3 from 20%, then −U from 60%: the speed changes sign, which separates Coulomb
     /// friction from a constant load.
     Reversal,
+    /// U and −U by turns, each for a twentieth of the record: twenty steps, each of 2U after
+    /// the first, where an effect that shows only at the input's steps (a delay) adds up.
+    Square,
 }
 
 impl InputProfile {
-    pub const ALL: [InputProfile; 3] = [
+    pub const ALL: [InputProfile; 4] = [
         InputProfile::Constant,
         InputProfile::Step,
         InputProfile::Reversal,
+        InputProfile::Square,
     ];
 
     /// The profile's name in files and on the command line.
@@ -32,6 +36,7 @@ impl InputProfile {
             InputProfile::Constant => "constant",
             InputProfile::Step => "step",
             InputProfile::Reversal => "reversal",
+            InputProfile::Square => "square",
         }
     }
 
@@ -43,6 +48,7 @@ impl InputProfile {
             InputProfile::Reversal => {
                 "U, then U/3 from 20%, then −U from 60%: the speed changes sign"
             }
+            InputProfile::Square => "U and −U by turns, each for a twentieth of the record",
         }
     }
 
@@ -62,6 +68,13 @@ impl InputProfile {
                     u
                 } else if t < 0.6 * t_end {
                     u / 3.0
+                } else {
+                    -u
+                }
+            }
+            InputProfile::Square => {
+                if (20.0 * t / t_end).floor() as i64 % 2 == 0 {
+                    u
                 } else {
                     -u
                 }

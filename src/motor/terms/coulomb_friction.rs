@@ -37,6 +37,7 @@ impl PhysicsTerm for CoulombFriction {
         unit: "rad/s",
         default: 1.0,
         speed_share: Some(0.01),
+        choices: &[],
     }];
 
     fn with_settings(s: &[f64]) -> Result<Self, String> {

@@ -30,7 +30,7 @@ impl PhysicsTerm for CurrentOffset {
         Ok(Self)
     }
 
-    fn measure<D: Scalar>(&self, p: &[D], channels: &mut [D]) {
+    fn measure<D: Scalar>(&self, p: &[D], _: &[D], channels: &mut [D]) {
         channels[0] += p[0];
     }
 }

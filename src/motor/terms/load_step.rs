@@ -66,6 +66,7 @@ impl PhysicsTerm for LoadStep {
         unit: "s",
         default: 1e-3,
         speed_share: None,
+        choices: &[],
     }];
 
     fn with_settings(s: &[f64]) -> Result<Self, String> {

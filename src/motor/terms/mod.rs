@@ -11,6 +11,8 @@
 use super::Scalar;
 use crate::parameter::{Prior, Support};
 
+pub use super::input::InputSteps;
+
 // Where the terms' files find what they amend and what their priors are scaled by; public, as
 // these paths were before the balances and magnitudes had files of their own.
 pub use super::balance::{Balance, Coefficients, Site};
@@ -35,6 +37,9 @@ pub struct TermSetting {
     /// smoothing speed must be small against the speeds the rig runs at, in whatever unit
     /// (1e-3 m/s on a ball screw, not 1 rad/s).
     pub speed_share: Option<f64>,
+    /// A setting that names one of these (a channel): files write the name, the term gets its
+    /// index as the value. Empty for a number.
+    pub choices: &'static [&'static str],
 }
 
 /// A state a term adds to the ODE, with its initial value.
@@ -54,10 +59,20 @@ pub trait PhysicsTerm: Sized + Clone + std::fmt::Debug + PartialEq {
     /// Whether the term acts on the mechanical equation alone, so that it also applies to the
     /// drive bases, where the electrical equation and the current sensor are not modelled.
     const MECHANICAL: bool = false;
+    /// Why a term that is not `MECHANICAL` does not apply to the drive bases, completing "term
+    /// X … which a <base> model does not have".
+    const NOT_ON_DRIVES: &'static str = "acts on the electrical equation or the current sensor";
     /// Whether a parameter is a time within the record (a switching time): such a term belongs
     /// to one record, and is not a candidate for several records at once, whose clocks are
     /// not one clock.
     const RECORD_TIME: bool = false;
+    /// Whether `diagnose` ranks the term among its candidates by default. The dynamic terms
+    /// (a delay, a filter, a resonance) are not: their fits cost several times a static term's
+    /// (an input history or extra stiff states), and a flat start rarely finds their valley,
+    /// whereas the unexplained verdict estimates the delay, the time constant or the frequency
+    /// directly. They are fitted from that fingerprint when it names them (`discover::named`),
+    /// and a user can still ask for them by name.
+    const SCREENED: bool = true;
 
     /// The term with its settings (in the order of `SETTINGS`), or why they are invalid.
     fn with_settings(settings: &[f64]) -> Result<Self, String>;
@@ -74,8 +89,14 @@ pub trait PhysicsTerm: Sized + Clone + std::fmt::Debug + PartialEq {
     fn contribute<D: Scalar>(&self, _site: &Site<D>, _b: &mut Balance<D>) {}
     /// Derivatives of the term's own states, after every term has contributed.
     fn derivatives<D: Scalar>(&self, _site: &Site<D>, _b: &Balance<D>, _d: &mut [D]) {}
-    /// Amends the measured channels (I, ω).
-    fn measure<D: Scalar>(&self, _params: &[D], _channels: &mut [D]) {}
+    /// The term's states at the start where they follow the base's initial state `base` (a
+    /// filter settled on its channel); otherwise `STATES`' fixed values stand.
+    fn initial<D: Scalar>(&self, _params: &[D], _base: &[D], _states: &mut [D]) {}
+    /// Amends the input the base is driven with at time t (the supply voltage): `u` is its value
+    /// there, `input` its whole history as steps, for a term that shifts it in time.
+    fn input<D: Scalar>(&self, _params: &[D], _t: f64, _input: &InputSteps<D>, _u: &mut D) {}
+    /// Amends the measured channels (I, ω); `states` are the term's own at that sample.
+    fn measure<D: Scalar>(&self, _params: &[D], _states: &[D], _channels: &mut [D]) {}
     /// Times at which the term makes the right-hand side jump, at nominal parameter values.
     fn breakpoints(&self, _params: &[f64]) -> Vec<f64> {
         Vec::new()
@@ -207,6 +228,14 @@ macro_rules! terms {
                 match self { $(Term::$variant(_) => <$variant as PhysicsTerm>::MECHANICAL),* }
             }
 
+            pub fn not_on_drives(&self) -> &'static str {
+                match self { $(Term::$variant(_) => <$variant as PhysicsTerm>::NOT_ON_DRIVES),* }
+            }
+
+            pub fn screened(&self) -> bool {
+                match self { $(Term::$variant(_) => <$variant as PhysicsTerm>::SCREENED),* }
+            }
+
             pub fn record_time(&self) -> bool {
                 match self { $(Term::$variant(_) => <$variant as PhysicsTerm>::RECORD_TIME),* }
             }
@@ -239,8 +268,24 @@ macro_rules! terms {
             }
 
             #[inline]
-            pub fn measure<D: Scalar>(&self, params: &[D], channels: &mut [D]) {
-                match self { $(Term::$variant(t) => t.measure(params, channels)),* }
+            pub fn initial<D: Scalar>(&self, params: &[D], base: &[D], states: &mut [D]) {
+                match self { $(Term::$variant(t) => t.initial(params, base, states)),* }
+            }
+
+            #[inline]
+            pub fn input<D: Scalar>(
+                &self,
+                params: &[D],
+                t: f64,
+                input: &InputSteps<D>,
+                u: &mut D,
+            ) {
+                match self { $(Term::$variant(t_) => t_.input(params, t, input, u)),* }
+            }
+
+            #[inline]
+            pub fn measure<D: Scalar>(&self, params: &[D], states: &[D], channels: &mut [D]) {
+                match self { $(Term::$variant(t) => t.measure(params, states, channels)),* }
             }
 
             pub fn breakpoints(&self, params: &[f64]) -> Vec<f64> {
@@ -261,6 +306,10 @@ terms!(
     voltage_drop::VoltageDrop,
     resistance_heating::ResistanceHeating,
     armature_reaction::ArmatureReaction,
+    input_delay::InputDelay,
+    compliant_coupling::CompliantCoupling,
+    // Before the sensors' offset and gain: the filter's output is what they then amend.
+    sensor_lag::SensorLag,
     current_offset::CurrentOffset,
     speed_gain::SpeedGain,
     asymmetric_friction::AsymmetricFriction,

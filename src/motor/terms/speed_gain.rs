@@ -15,7 +15,7 @@ impl PhysicsTerm for SpeedGain {
         Ok(Self)
     }
 
-    fn measure<D: Scalar>(&self, p: &[D], channels: &mut [D]) {
+    fn measure<D: Scalar>(&self, p: &[D], _: &[D], channels: &mut [D]) {
         channels[1] *= p[0] + 1.0;
     }
 }

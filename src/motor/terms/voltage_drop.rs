@@ -35,6 +35,7 @@ impl PhysicsTerm for VoltageDrop {
         unit: "A",
         default: 1.0,
         speed_share: None,
+        choices: &[],
     }];
 
     fn with_settings(s: &[f64]) -> Result<Self, String> {

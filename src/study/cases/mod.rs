@@ -5,7 +5,7 @@
 //! 0.5 s with σ_I = 2 A and σ_ω = 10 rad/s. `--conceal` keeps that peak below 1.5σ and redraws a
 //! case until the oracle ([`oracle`]) finds the effect identifiable on the noise-free truth; an
 //! effect that is not identifiable on the asked input after [`REDRAWS`] draws moves to a richer
-//! one (constant → step → reversal), recorded in `answer.json`.
+//! one (constant → step → reversal → square), recorded in `answer.json`.
 
 pub mod oracle;
 
@@ -177,18 +177,40 @@ fn scale_effect(
         let (p, _) = peak_over_sigma(base, &truth)?;
         Ok(p[0].max(p[1]))
     };
+    // A size too small for the integrator to resolve (a lag of nanoseconds, stiff) is below
+    // any target: the bracket goes on doubling past it.
+    let peak_or_zero = |size: f64| -> Result<f64, Error> {
+        match peak(size) {
+            Err(Error::Numerical(_)) => Ok(0.0),
+            other => other,
+        }
+    };
+    // A bounded size (a share) stops short of its bound: the effect is then as large as it gets.
+    let ceiling = match Term::named(name).map(|t| t.params()[0].support) {
+        Some(support) => {
+            match support(&base.model_for(&base.recordings[0])?.magnitudes(DURATION)) {
+                Support::Bounded { upper, .. } => 0.95 * upper,
+                _ => f64::INFINITY,
+            }
+        }
+        None => f64::INFINITY,
+    };
     let mut lo = 1e-9;
     let mut hi = 1e-9;
     for _ in 0..80 {
-        if peak(hi)? >= target {
+        if peak_or_zero(hi)? >= target {
             break;
         }
         lo = hi;
         hi *= 2.0;
+        if hi >= ceiling {
+            hi = ceiling;
+            break;
+        }
     }
     for _ in 0..40 {
         let mid = (lo * hi).sqrt();
-        if peak(mid)? < target {
+        if peak_or_zero(mid)? < target {
             lo = mid;
         } else {
             hi = mid;
@@ -286,11 +308,7 @@ pub fn make_case(options: &CaseOptions) -> Result<Case, Error> {
     }
     let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
     let times = sample_times(DURATION, SAMPLES);
-    let ladder = [
-        InputProfile::Constant,
-        InputProfile::Step,
-        InputProfile::Reversal,
-    ];
+    let ladder = InputProfile::ALL;
     let first = ladder.iter().position(|i| *i == options.input).unwrap_or(0);
     let mut attempts = 0;
     for (rung, &input) in ladder.iter().enumerate().skip(first) {
@@ -313,8 +331,12 @@ pub fn make_case(options: &CaseOptions) -> Result<Case, Error> {
                 let drawn: Vec<f64> = term
                     .params()
                     .iter()
-                    .map(|p| match p.key {
-                        "t_s" => rng.random_range(0.2..0.8) * DURATION,
+                    .map(|p| match (name.as_str(), p.key) {
+                        (_, "t_s") => rng.random_range(0.2..0.8) * DURATION,
+                        // A resonance the record resolves (ten samples a period at the most),
+                        // lightly damped: it rings for a few periods after each step.
+                        ("compliant_coupling", "f_r") => rng.random_range(30.0..100.0),
+                        ("compliant_coupling", "zeta") => rng.random_range(0.05..0.2),
                         _ => p.default,
                     })
                     .collect();
