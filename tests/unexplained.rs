@@ -144,3 +144,40 @@ fn a_recording_of_the_model_itself_leaves_nothing_unexplained() {
         assert!(verdict(&problem).is_none(), "seed {seed}");
     }
 }
+
+/// With the whole library (the dynamic terms included, as `diagnose` runs by default) the
+/// fingerprint names its term, the term is fitted from the fingerprint's estimate and taken by
+/// the ranking's threshold, its parameter lands within 30% of the truth, and nothing is left.
+fn named_and_explained(name: &str, term: &str, key: &str, truth_key: &str) {
+    let (problem, answer) = fixture(name);
+    let mut s = settings();
+    s.candidates = None;
+    let d = discover(&problem, &s).unwrap();
+    eprintln!("{name}: {:?} {:?}", d.selected_set, d.selected_params);
+    assert_eq!(d.selected_set, vec![term.to_string()], "{name}");
+    let estimate = d.selected_params[&format!("{term}.{key}")];
+    let truth = answer["fingerprint"][truth_key].as_f64().unwrap();
+    assert!(within(estimate, truth, 0.3), "{estimate} vs {truth}");
+    assert!(d.unexplained.is_none(), "{:?}", d.unexplained);
+    assert!(!d.residual_mismatch);
+}
+
+#[test]
+fn a_delay_fingerprint_names_input_delay_and_its_fit_leaves_nothing() {
+    named_and_explained("input_delay-510007", "input_delay", "tau", "seconds");
+}
+
+#[test]
+fn a_lag_fingerprint_names_sensor_lag_and_its_fit_leaves_nothing() {
+    named_and_explained("sensor_lag-510008", "sensor_lag", "tau", "seconds");
+}
+
+#[test]
+fn a_ringing_fingerprint_names_compliant_coupling_and_its_fit_leaves_nothing() {
+    named_and_explained(
+        "compliant_coupling-510018",
+        "compliant_coupling",
+        "f_r",
+        "frequency_hz",
+    );
+}

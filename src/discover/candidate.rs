@@ -97,9 +97,20 @@ pub fn fit_candidate_from(
     added: &[String],
     warm: Option<&Candidate>,
 ) -> Result<Candidate, Error> {
-    let problem = base.with_terms(added)?;
+    let start = warm.map(|w| w.theta.clone()).unwrap_or_default();
+    fit_candidate_at(base.with_terms(added)?, added, &start)
+}
+
+/// As [`fit_candidate`] on `problem`, the base with `added` already switched on (their
+/// settings chosen, as a filtered channel is), starting each parameter `start` names at that
+/// value: a dynamic term named by a fingerprint starts at the fingerprint's estimate.
+pub fn fit_candidate_at(
+    problem: Problem,
+    added: &[String],
+    start: &BTreeMap<String, f64>,
+) -> Result<Candidate, Error> {
     let mut posterior = problem.posterior(&ModelSettings::bm1())?;
-    let map = best_map(&mut posterior, warm, uses_laplace(&problem))?;
+    let map = best_map(&mut posterior, start, uses_laplace(&problem))?;
     let log_likelihood = posterior.log_likelihood(&map.x)?;
     let added_names: Vec<String> = posterior
         .calibrated()
@@ -146,15 +157,16 @@ pub fn fit_candidate_from(
     })
 }
 
-/// The MAP from the posterior's own start, and for a bounded parameter (a switching time) from
+/// The MAP from the posterior's own start (the values `known_values` names where it names
+/// them), and for a bounded parameter (a switching time) from
 /// several starts across its support: the best one.
 fn best_map(
     posterior: &mut CalibrationPosterior,
-    warm: Option<&Candidate>,
+    known_values: &BTreeMap<String, f64>,
     long_record: bool,
 ) -> Result<MapEstimate, Error> {
     let mut start = posterior.initial_point()?;
-    let known = |name: &str| warm.and_then(|w| w.theta.get(name).copied());
+    let known = |name: &str| known_values.get(name).copied();
     for (i, c) in posterior.calibrated().iter().enumerate() {
         if let Some(value) = known(&c.name)
             && c.support.interior(value)

@@ -18,6 +18,7 @@ use super::Progress;
 use super::candidate::{Candidate, Confirmation, answer_params};
 use super::coincide::InputCoincidence;
 use super::fits::{self, Convergence, FitSummary, Mismatch, SampledFit};
+use super::named::fit_named_terms;
 use super::screen::collinear_pairs;
 use super::selection::Selection;
 use super::settings::{
@@ -191,10 +192,32 @@ pub fn assemble(
         .expect("none is ranked")
         .clone();
     let Selection {
-        terms: selected_set,
-        fit: selected_fit,
+        terms: mut selected_set,
+        fit: mut selected_fit,
         passed_over,
     } = selection;
+    // The verdict after the library's selection; where its fingerprint names a dynamic term
+    // that then fits better, the term joins (or replaces) the selection and the verdict is
+    // asked again after it.
+    let mut left = unexplained(problem, &selected_fit, &none)?;
+    let mut ranking = ranking;
+    if let Some(verdict) = &left
+        && let Some(fit) = fit_named_terms(
+            problem,
+            verdict,
+            &selected_fit,
+            &none,
+            settings.candidates.as_deref(),
+        )?
+    {
+        selected_set = fit.added.clone();
+        selected_fit = fit;
+        if selected_fit.added.len() == 1 {
+            ranking.push(selected_fit.clone());
+            ranking.sort_by(|a, b| b.score.total_cmp(&a.score));
+        }
+        left = unexplained(problem, &selected_fit, &none)?;
+    }
     let passed_over: Vec<PassedOver> = passed_over
         .iter()
         .filter_map(|f| {
@@ -293,7 +316,6 @@ pub fn assemble(
             tie_experiments.insert(pair.join("/"), "reversal".into());
         }
     }
-    let left = unexplained(problem, &selected_fit, &none)?;
     let mut diagnosis = Diagnosis {
         selected,
         selected_set: selected_set.clone(),
