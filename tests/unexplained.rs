@@ -146,8 +146,8 @@ fn a_recording_of_the_model_itself_leaves_nothing_unexplained() {
 }
 
 /// With the whole library (the dynamic terms included, as `diagnose` runs by default) the
-/// fingerprint names its term, the term is fitted from the fingerprint's estimate and taken by
-/// the ranking's threshold, its parameter lands within 30% of the truth, and nothing is left.
+/// dynamic term is ranked from the verdict's estimate on the model as given (its start), taken
+/// by the ranking's threshold, its parameter lands within 30% of the truth, and nothing is left.
 fn named_and_explained(name: &str, term: &str, key: &str, truth_key: &str) {
     let (problem, answer) = fixture(name);
     let mut s = settings();

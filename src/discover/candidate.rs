@@ -17,12 +17,14 @@ use std::collections::BTreeMap;
 use crate::bayes::{CalibrationPosterior, ModelSettings};
 use crate::density::LogDensity;
 use crate::error::Error;
+use crate::motor::Term;
 use crate::optimize::{MapEstimate, MapSettings, find_map};
 use crate::parameter::{ParamId, Support};
 use crate::study::{BOUNDED_STARTS, Problem};
 
 use super::coincide::{InputCoincidence, coincidence};
 use super::settings::uses_laplace;
+use super::unexplained::DYNAMIC;
 
 /// How many starts a long record's MAP search keeps (the best by their log density).
 pub const LONG_RECORD_STARTS: usize = 2;
@@ -47,7 +49,7 @@ pub struct Candidate {
     pub log_likelihood: f64,
     /// Laplace evidence with the default priors (reported, not ranked by).
     pub log_evidence_laplace: f64,
-    /// log L̂ − ½·d·ln N.
+    /// log L̂ − ½·d·ln N (less a searched start's multiplicity, [`Starts::search_penalty`]).
     pub score: f64,
     /// Calibrated parameters at the MAP (physical values), keyed by the model's names.
     pub theta: BTreeMap<String, f64>,
@@ -97,8 +99,50 @@ pub fn fit_candidate_from(
     added: &[String],
     warm: Option<&Candidate>,
 ) -> Result<Candidate, Error> {
-    let start = warm.map(|w| w.theta.clone()).unwrap_or_default();
-    fit_candidate_at(base.with_terms(added)?, added, &start)
+    fit_candidate_started(base, added, warm, &Starts::default())
+}
+
+/// Where the dynamic terms (a delay, a sensor's lag, a resonance) start when they are ranked,
+/// and the settings they take: estimates the unexplained verdict's searches make on the
+/// residual of the model as given (`unexplained::dynamic_starts`). From the defaults (τ = 0,
+/// a resonance at 100 Hz) a MAP search rarely finds their valley.
+#[derive(Clone, Debug, Default)]
+pub struct Starts {
+    /// Start values, keyed as [`Candidate::theta`] keys them.
+    pub values: BTreeMap<String, f64>,
+    /// Terms with the settings the estimates chose (the channel a lag is on).
+    pub terms: Vec<Term>,
+    /// Nats a term's score pays because its start was the best of a grid of G points (a
+    /// frequency): ln G, the Bonferroni bound on the best of G, as the verdict's sinusoid pays.
+    pub search_penalty: BTreeMap<String, f64>,
+}
+
+/// As [`fit_candidate_from`], the dynamic terms among `added` started (and set) as `starts`
+/// says; `warm`'s estimates take precedence for the parameters it has.
+pub fn fit_candidate_started(
+    base: &Problem,
+    added: &[String],
+    warm: Option<&Candidate>,
+    starts: &Starts,
+) -> Result<Candidate, Error> {
+    let mut problem = base.with_terms(added)?;
+    for active in &mut problem.model.terms {
+        let name = active.term.name();
+        if added.iter().any(|a| a == name)
+            && let Some(set) = starts.terms.iter().find(|t| t.name() == name)
+        {
+            active.term = set.clone();
+        }
+    }
+    let mut start = starts.values.clone();
+    if let Some(w) = warm {
+        start.extend(w.theta.iter().map(|(k, v)| (k.clone(), *v)));
+    }
+    let penalty = added
+        .iter()
+        .filter_map(|a| starts.search_penalty.get(a))
+        .sum();
+    fit_candidate_at(problem, added, &start, penalty)
 }
 
 /// As [`fit_candidate`] on `problem`, the base with `added` already switched on (their
@@ -108,9 +152,17 @@ pub fn fit_candidate_at(
     problem: Problem,
     added: &[String],
     start: &BTreeMap<String, f64>,
+    search_penalty: f64,
 ) -> Result<Candidate, Error> {
     let mut posterior = problem.posterior(&ModelSettings::bm1())?;
-    let map = best_map(&mut posterior, start, uses_laplace(&problem))?;
+    // A dynamic term (a filter's state, a coupled load's two, a delayed input's history) makes
+    // every solve several times dearer.
+    let costly_solve = problem
+        .model
+        .terms
+        .iter()
+        .any(|t| DYNAMIC.contains(&t.term.name()));
+    let map = best_map(&mut posterior, start, uses_laplace(&problem), costly_solve)?;
     let log_likelihood = posterior.log_likelihood(&map.x)?;
     let added_names: Vec<String> = posterior
         .calibrated()
@@ -148,7 +200,7 @@ pub fn fit_candidate_at(
         n_added,
         log_likelihood,
         log_evidence_laplace: map.log_evidence_laplace,
-        score: log_likelihood - 0.5 * n_added as f64 * n.ln(),
+        score: log_likelihood - 0.5 * n_added as f64 * n.ln() - search_penalty,
         map,
         theta,
         at_bound,
@@ -164,6 +216,7 @@ fn best_map(
     posterior: &mut CalibrationPosterior,
     known_values: &BTreeMap<String, f64>,
     long_record: bool,
+    costly_solve: bool,
 ) -> Result<MapEstimate, Error> {
     let mut start = posterior.initial_point()?;
     let known = |name: &str| known_values.get(name).copied();
@@ -209,9 +262,10 @@ fn best_map(
             starts.push(s);
         }
     }
-    if long_record && starts.len() > LONG_RECORD_STARTS {
-        // A MAP search on 20 000 samples costs seconds; the starts' own log densities (one
-        // plain solve each) pick the valleys worth searching.
+    if (long_record || costly_solve) && starts.len() > LONG_RECORD_STARTS {
+        // A MAP search on 20 000 samples, or through a resonance's or a filter's extra states,
+        // costs seconds; the starts' own log densities (one plain solve each) pick the valleys
+        // worth searching.
         let mut scored: Vec<(f64, Vec<f64>)> = starts
             .into_iter()
             .map(|s| (posterior.log_density(&s).unwrap_or(f64::NEG_INFINITY), s))

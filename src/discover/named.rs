@@ -9,8 +9,6 @@
 //! (log L̂ − ½·d·ln N), and taken when the better of the two beats the selected model by more
 //! than [`EVIDENCE_THRESHOLD`]: the ranking's rule, for the ranking's reason.
 
-use std::collections::BTreeMap;
-
 use rayon::prelude::*;
 
 use crate::error::Error;
@@ -18,7 +16,7 @@ use crate::motor::Term;
 use crate::parameter::ParamId;
 use crate::study::Problem;
 
-use super::candidate::{Candidate, fit_candidate_at};
+use super::candidate::{Candidate, Starts, fit_candidate_started};
 use super::settings::EVIDENCE_THRESHOLD;
 use super::unexplained::{Fingerprint, Unexplained};
 
@@ -27,10 +25,13 @@ use super::unexplained::{Fingerprint, Unexplained};
 pub struct NamedTerm {
     pub term: Term,
     pub start: Vec<(&'static str, f64)>,
+    /// ln of the grid its start was the best of (a frequency), paid by its score.
+    pub search_penalty: f64,
 }
 
 /// The term `fingerprint` names on `problem`'s base, if one does.
 pub fn named_term(problem: &Problem, fingerprint: &Fingerprint) -> Option<NamedTerm> {
+    let mut search_penalty = 0.0;
     let (term, start) = match fingerprint {
         Fingerprint::Delay { seconds, .. } => {
             (Term::named("input_delay")?, vec![("tau", *seconds)])
@@ -46,14 +47,18 @@ pub fn named_term(problem: &Problem, fingerprint: &Fingerprint) -> Option<NamedT
             frequency_hz,
             damping_ratio,
             ringing: true,
+            grid_points,
             ..
-        } => (
-            Term::named("compliant_coupling")?,
-            vec![
-                ("f_r", *frequency_hz),
-                ("zeta", damping_ratio.unwrap_or(0.1).clamp(1e-3, 1.0)),
-            ],
-        ),
+        } => {
+            search_penalty = (*grid_points.max(&1) as f64).ln();
+            (
+                Term::named("compliant_coupling")?,
+                vec![
+                    ("f_r", *frequency_hz),
+                    ("zeta", damping_ratio.unwrap_or(0.1).clamp(1e-3, 1.0)),
+                ],
+            )
+        }
         _ => return None,
     };
     let present = problem
@@ -61,30 +66,38 @@ pub fn named_term(problem: &Problem, fingerprint: &Fingerprint) -> Option<NamedT
         .terms
         .iter()
         .any(|t| t.term.name() == term.name());
-    (problem.model.base.accepts(&term) && !present).then_some(NamedTerm { term, start })
+    (problem.model.base.accepts(&term) && !present).then_some(NamedTerm {
+        term,
+        start,
+        search_penalty,
+    })
 }
 
 /// `named` fitted beside `with` (the selected terms, or none), started at `with`'s estimates
-/// and the fingerprint's.
+/// and the fingerprint's; a frequency found by a grid search pays the grid's multiplicity, as
+/// in the ranking.
 fn fit_named(problem: &Problem, with: &Candidate, named: &NamedTerm) -> Result<Candidate, Error> {
+    let search_penalty = named.search_penalty;
     let name = named.term.name().to_string();
     let mut added = with.added.clone();
     added.push(name.clone());
-    let mut amended = problem.with_terms(&added)?;
-    for active in &mut amended.model.terms {
-        if active.term.name() == name {
-            active.term = named.term.clone();
-        }
-    }
-    let mut start: BTreeMap<String, f64> = with.theta.clone();
+    let mut starts = Starts {
+        terms: vec![named.term.clone()],
+        ..Starts::default()
+    };
     for &(key, value) in &named.start {
-        start.insert(ParamId::of_term(&name, key).to_string(), value);
+        starts
+            .values
+            .insert(ParamId::of_term(&name, key).to_string(), value);
     }
-    fit_candidate_at(amended, &added, &start)
+    if search_penalty > 0.0 {
+        starts.search_penalty.insert(name, search_penalty);
+    }
+    fit_candidate_started(problem, &added, Some(with), &starts)
 }
 
-/// The best fit of a term the verdict's fingerprints name (the leader's first, then the
-/// alternatives'), when it beats `selected` by more than the threshold. Where the user named
+/// The best fit of a term the verdict's fingerprints name (every kind that cleared the
+/// threshold on its own, not only the leader: the fits, not the linearised scores, decide), when it beats `selected` by more than the threshold. Where the user named
 /// the candidates (`allowed`), only those may be added: the list says what the diagnosis may
 /// add to the model, whichever way it finds them.
 pub fn fit_named_terms(
@@ -95,7 +108,7 @@ pub fn fit_named_terms(
     allowed: Option<&[String]>,
 ) -> Result<Option<Candidate>, Error> {
     let mut named: Vec<NamedTerm> = Vec::new();
-    for f in std::iter::once(&left.fingerprint).chain(&left.alternatives) {
+    for f in std::iter::once(&left.fingerprint).chain(&left.considered) {
         if let Some(n) = named_term(problem, f)
             && !named.iter().any(|m| m.term.name() == n.term.name())
             && allowed.is_none_or(|a| a.iter().any(|c| c == n.term.name()))

@@ -7,20 +7,26 @@ use rayon::prelude::*;
 use crate::error::Error;
 use crate::study::Problem;
 
-use super::candidate::{Candidate, fit_candidate, fit_candidate_from};
+use super::candidate::{Candidate, fit_candidate, fit_candidate_started};
 use super::confirm::importance_evidence;
 use super::settings::{EVIDENCE_THRESHOLD, MAX_TERMS};
 use super::state::records_reverse;
+use super::unexplained::{DYNAMIC, StepScreen, dynamic_starts};
 
 /// Ranks `candidates` one at a time against the model without them, best first.
 /// Fits are deterministic and independent, so they run in parallel without changing a bit.
+/// The model as given is fitted first: the dynamic terms start where its residual says
+/// (`dynamic_starts`).
 pub fn rank(problem: &Problem, candidates: &[String]) -> Result<Vec<Candidate>, Error> {
-    let mut sets: Vec<Vec<String>> = vec![Vec::new()];
-    sets.extend(candidates.iter().map(|c| vec![c.clone()]));
-    let mut fits = sets
-        .par_iter()
-        .map(|added| fit_candidate(problem, added))
-        .collect::<Result<Vec<_>, _>>()?;
+    let none = fit_candidate(problem, &[])?;
+    let starts = dynamic_starts(problem, &none, candidates)?;
+    let mut fits = vec![none];
+    fits.extend(
+        candidates
+            .par_iter()
+            .map(|c| fit_candidate_started(problem, std::slice::from_ref(c), None, &starts))
+            .collect::<Result<Vec<_>, _>>()?,
+    );
     // Stable: equal scores keep the candidates' canonical order.
     fits.sort_by(|a, b| b.score.total_cmp(&a.score));
     confirm_leaders(&mut fits)?;
@@ -76,6 +82,7 @@ pub fn forward_selection(
         .filter(|f| beats(f, &none))
         .cloned()
         .collect();
+    let starts = dynamic_starts(problem, &none, candidates)?;
     let best = ranking
         .iter()
         .find(|f| f.coincidence.is_none())
@@ -101,10 +108,30 @@ pub fn forward_selection(
             )
     };
     while current.added.len() < MAX_TERMS {
+        // Beside a dynamic term every fit is dear: candidates the first-order screen rules out
+        // are not fitted (`StepScreen`).
+        let dear = |name: &str| {
+            current
+                .added
+                .iter()
+                .chain(std::iter::once(&name.to_string()))
+                .any(|a| DYNAMIC.contains(&a.as_str()))
+        };
+        let screen = if problem.recordings.len() == 1 && candidates.iter().any(|c| dear(c)) {
+            Some(StepScreen::of(problem, &current)?)
+        } else {
+            None
+        };
         let sets: Vec<Vec<String>> = candidates
             .iter()
             .filter(|name| !current.added.contains(name))
             .filter(|name| !current.added.iter().any(|a| same_torque(a, name)))
+            .filter(|name| {
+                !dear(name)
+                    || screen
+                        .as_ref()
+                        .is_none_or(|s| s.worth_fitting(&current, name, &starts))
+            })
             .map(|name| {
                 let mut added = current.added.clone();
                 added.push(name.clone());
@@ -113,7 +140,7 @@ pub fn forward_selection(
             .collect();
         let fits = sets
             .par_iter()
-            .map(|added| fit_candidate_from(problem, added, Some(&current)))
+            .map(|added| fit_candidate_started(problem, added, Some(&current), &starts))
             .collect::<Result<Vec<_>, _>>()?;
         let mut next: Option<Candidate> = None;
         let mut confounded: Vec<Candidate> = Vec::new();

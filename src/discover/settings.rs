@@ -129,8 +129,7 @@ impl FitStage {
     }
 }
 
-/// The candidates to rank: the given names (checked) or every screened term the model lacks
-/// (the dynamic ones are fitted where the unexplained verdict names them).
+/// The candidates to rank: the given names (checked) or every term the model lacks.
 pub fn candidate_names(problem: &Problem, given: Option<&[String]>) -> Result<Vec<String>, Error> {
     let present = |name: &str| problem.model.terms.iter().any(|t| t.term.name() == name);
     let base = problem.model.base;
@@ -172,7 +171,6 @@ pub fn candidate_names(problem: &Problem, given: Option<&[String]>) -> Result<Ve
         None => Ok(Term::NAMES
             .iter()
             .filter(|n| !present(n) && applies(n))
-            .filter(|n| Term::named(n).is_some_and(|t| t.screened()))
             .map(|n| n.to_string())
             .collect()),
     }

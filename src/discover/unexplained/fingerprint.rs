@@ -14,6 +14,9 @@ pub enum Fingerprint {
         channel: String,
         ringing: bool,
         score: f64,
+        /// The points its search ran over: a fit started at it pays ln of this.
+        #[serde(skip)]
+        grid_points: usize,
     },
     Delay {
         seconds: f64,

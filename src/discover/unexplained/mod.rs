@@ -28,6 +28,8 @@
 mod fingerprint;
 mod oscillation;
 mod regression;
+mod starts;
+mod step_screen;
 mod timing;
 
 use nalgebra::{DMatrix, DVector};
@@ -44,6 +46,8 @@ use super::settings::EVIDENCE_THRESHOLD;
 pub use fingerprint::Fingerprint;
 use oscillation::Oscillation;
 use regression::{Explained, Projector, explain};
+pub use starts::{DYNAMIC, dynamic_starts};
+pub use step_screen::StepScreen;
 use timing::FinePrediction;
 
 /// Input steps (besides the record's start) a ringing oscillation is fitted after at most: the
@@ -210,6 +214,10 @@ pub struct Unexplained {
     pub spans: Vec<Span>,
     pub fingerprint: Fingerprint,
     pub alternatives: Vec<Fingerprint>,
+    /// Every kind that clears the threshold on its own, best first, the leader among them (a
+    /// delay beaten by a lag on one channel is still worth fitting as the term it names).
+    #[serde(skip)]
+    pub considered: Vec<Fingerprint>,
     pub suggestion: String,
     /// The evidence behind the fingerprint, for the command's figure.
     #[serde(skip)]
@@ -340,6 +348,7 @@ fn oscillation_fingerprint(o: &Oscillation, channel: &str, shift: f64) -> Finger
         channel: channel.to_string(),
         ringing: o.ringing(),
         score: o.scored.score - shift,
+        grid_points: o.points,
     }
 }
 
@@ -446,6 +455,11 @@ pub fn unexplained(
     }
     let lead = rank(&candidates[0].fingerprint);
     let fingerprint = candidates[0].fingerprint.clone();
+    let considered: Vec<Fingerprint> = candidates
+        .iter()
+        .map(|e| e.fingerprint.clone())
+        .filter(|f| f.score() > EVIDENCE_THRESHOLD)
+        .collect();
     let alternatives: Vec<Fingerprint> = candidates[1..]
         .iter()
         .map(|e| e.fingerprint.clone())
@@ -490,6 +504,7 @@ pub fn unexplained(
         spans: where_,
         fingerprint,
         alternatives,
+        considered,
         suggestion,
         figure,
     }))

@@ -30,6 +30,9 @@ pub struct Oscillation {
     /// The decay rate λ [1/s] of a ringing oscillation (none for one that runs on).
     pub decay: Option<f64>,
     pub scored: Scored,
+    /// The points its search ran over (frequencies, and decay times for a ringing one): what
+    /// its best pays, ln of this, wherever its estimate is used.
+    pub points: usize,
 }
 
 impl Oscillation {
@@ -197,6 +200,7 @@ pub fn search(ctx: &Context, c: usize) -> Vec<Oscillation> {
             frequency_sd,
             decay,
             scored: Scored::new(e, penalty),
+            points,
         });
     }
     out

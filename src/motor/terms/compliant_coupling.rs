@@ -61,7 +61,6 @@ impl PhysicsTerm for CompliantCoupling {
     const NAME: &'static str = "compliant_coupling";
     const EQUATION: &'static str = "(1 − s)J dω/dt = … − s(1 − s)J·(ω_r²φ + 2ζω_r(ω − ω_l)), \
                                     dφ/dt = ω − ω_l, dω_l/dt = (1 − s)(ω_r²φ + 2ζω_r(ω − ω_l))";
-    const SCREENED: bool = false;
     const NOT_ON_DRIVES: &'static str =
         "rings faster than the steps fixed to a drive base's samples resolve";
     const PARAMS: &'static [TermParam] = &[

@@ -38,7 +38,6 @@ fn smoothstep<D: Scalar>(z: D) -> D {
 impl PhysicsTerm for InputDelay {
     const NAME: &'static str = "input_delay";
     const EQUATION: &'static str = "U(t) → U(t − τ) (each step a ramp of width `width`)";
-    const SCREENED: bool = false;
     const NOT_ON_DRIVES: &'static str =
         "delays the supply voltage (a drive base's input is its own, sampled)";
     const PARAMS: &'static [TermParam] = &[TermParam {

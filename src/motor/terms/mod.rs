@@ -66,13 +66,6 @@ pub trait PhysicsTerm: Sized + Clone + std::fmt::Debug + PartialEq {
     /// to one record, and is not a candidate for several records at once, whose clocks are
     /// not one clock.
     const RECORD_TIME: bool = false;
-    /// Whether `diagnose` ranks the term among its candidates by default. The dynamic terms
-    /// (a delay, a filter, a resonance) are not: their fits cost several times a static term's
-    /// (an input history or extra stiff states), and a flat start rarely finds their valley,
-    /// whereas the unexplained verdict estimates the delay, the time constant or the frequency
-    /// directly. They are fitted from that fingerprint when it names them (`discover::named`),
-    /// and a user can still ask for them by name.
-    const SCREENED: bool = true;
 
     /// The term with its settings (in the order of `SETTINGS`), or why they are invalid.
     fn with_settings(settings: &[f64]) -> Result<Self, String>;
@@ -230,10 +223,6 @@ macro_rules! terms {
 
             pub fn not_on_drives(&self) -> &'static str {
                 match self { $(Term::$variant(_) => <$variant as PhysicsTerm>::NOT_ON_DRIVES),* }
-            }
-
-            pub fn screened(&self) -> bool {
-                match self { $(Term::$variant(_) => <$variant as PhysicsTerm>::SCREENED),* }
             }
 
             pub fn record_time(&self) -> bool {

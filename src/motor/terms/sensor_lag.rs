@@ -30,7 +30,6 @@ fn prior(m: &Magnitudes) -> Prior {
 impl PhysicsTerm for SensorLag {
     const NAME: &'static str = "sensor_lag";
     const EQUATION: &'static str = "measured x = y, τ·dy/dt = x − y, y(0) = x(0) (x = I or ω)";
-    const SCREENED: bool = false;
     const NOT_ON_DRIVES: &'static str =
         "filters faster than the steps fixed to a drive base's samples resolve";
     const PARAMS: &'static [TermParam] = &[TermParam {

@@ -25,7 +25,7 @@ use crate::study::InputProfile;
 use crate::study::Problem;
 use crate::synthetic::sample_times;
 
-use oracle::{NONE_MARGIN, RUNNER_UP_MARGIN, least_squares};
+use oracle::{NONE_MARGIN, RUNNER_UP_MARGIN, least_squares, least_squares_set};
 
 pub const NOISE_SD: [f64; 2] = [2.0, 10.0];
 pub const SAMPLES: usize = 501;
@@ -229,12 +229,13 @@ fn oracle_margins(
     effects: &[String],
 ) -> Result<(f64, String, f64), Error> {
     let n = (2 * SAMPLES) as f64;
-    let score = |added: &[String]| -> Result<f64, Error> {
+    let score_set = |added: &[String], set: &[Term]| -> Result<f64, Error> {
         let problem = base.with_terms(added)?;
         let d = problem.calibrated_names()?.len() as f64 - 1.0;
-        let (ss, _) = least_squares(base, added, truth, &NOISE_SD)?;
+        let (ss, _) = least_squares_set(base, added, set, truth, &NOISE_SD)?;
         Ok(-0.5 * ss - 0.5 * d * n.ln())
     };
+    let score = |added: &[String]| score_set(added, &[]);
     let own = score(effects)?;
     let none = score(&[])?;
     let mut alternatives: Vec<Vec<String>> = Vec::new();
@@ -261,8 +262,42 @@ fn oracle_margins(
         if s > runner_up.1 {
             runner_up = (alt.join("+"), s);
         }
+        // A term with a choice among channels is an alternative on each of them: `diagnose`
+        // fits a lag on whichever channel the residual points to.
+        for set in choice_variants(&alt) {
+            let s = score_set(&alt, std::slice::from_ref(&set))?;
+            if s > runner_up.1 {
+                runner_up = (format!("{} ({:?})", alt.join("+"), set), s);
+            }
+        }
     }
     Ok((own - runner_up.1, runner_up.0, own - none))
+}
+
+/// The terms among `names` with a setting that chooses (a channel), at each choice other than
+/// the default.
+fn choice_variants(names: &[String]) -> Vec<Term> {
+    let mut out = Vec::new();
+    for name in names {
+        let (Some((_, settings)), Some(term)) = (Term::declarations(name), Term::named(name))
+        else {
+            continue;
+        };
+        let defaults = term.settings();
+        for (k, s) in settings.iter().enumerate() {
+            for index in 0..s.choices.len() {
+                if index as f64 == defaults[k] {
+                    continue;
+                }
+                let mut values = defaults.clone();
+                values[k] = index as f64;
+                if let Some(Ok(t)) = Term::from_name(name, &values) {
+                    out.push(t);
+                }
+            }
+        }
+    }
+    out
 }
 
 pub fn make_case(options: &CaseOptions) -> Result<Case, Error> {

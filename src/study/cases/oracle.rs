@@ -10,6 +10,7 @@
 use nalgebra::{DMatrix, DVector};
 
 use crate::error::Error;
+use crate::motor::Term;
 use crate::ode::SolverSettings;
 use crate::parameter::Support;
 use crate::study::Problem;
@@ -28,7 +29,24 @@ pub fn least_squares(
     target: &[f64],
     noise_sd: &[f64],
 ) -> Result<(f64, Vec<f64>), Error> {
-    let problem = base.with_terms(added)?;
+    least_squares_set(base, added, &[], target, noise_sd)
+}
+
+/// As [`least_squares`], the added terms named in `set` taking its settings (a lag on I rather
+/// than the default ω).
+pub fn least_squares_set(
+    base: &Problem,
+    added: &[String],
+    set: &[Term],
+    target: &[f64],
+    noise_sd: &[f64],
+) -> Result<(f64, Vec<f64>), Error> {
+    let mut problem = base.with_terms(added)?;
+    for active in &mut problem.model.terms {
+        if let Some(t) = set.iter().find(|t| t.name() == active.term.name()) {
+            active.term = t.clone();
+        }
+    }
     let forward = problem.forward(SolverSettings::default())?;
     let specs = forward.calibrated_specs();
     let m = forward.times().len();

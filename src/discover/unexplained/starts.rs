@@ -1,0 +1,78 @@
+//! Where the dynamic terms start when they are ranked: the verdict's own estimates on the
+//! residual of the model as given, whatever their evidence. A delay's τ, a lag's τ and the
+//! channel it is on, a ringing resonance's frequency and damping ratio are what a MAP search
+//! from the terms' defaults (τ = 0 on its bound, a resonance at 100 Hz) cannot find by itself:
+//! the likelihood in a frequency has a valley per harmonic, and at τ = 0 the gradient of a lag
+//! on one channel is no guide to which channel.
+
+use crate::error::Error;
+use crate::motor::Term;
+use crate::parameter::ParamId;
+use crate::study::Problem;
+
+use super::super::candidate::{Candidate, Starts};
+use super::{Context, Fingerprint, scores};
+
+/// The dynamic terms the starts are for.
+pub const DYNAMIC: [&str; 3] = ["input_delay", "sensor_lag", "compliant_coupling"];
+
+/// Starts for the dynamic terms among `candidates`, estimated on `none` (the model as given at
+/// its MAP, first record); empty when there are none to start.
+pub fn dynamic_starts(
+    problem: &Problem,
+    none: &Candidate,
+    candidates: &[String],
+) -> Result<Starts, Error> {
+    let mut starts = Starts::default();
+    if !candidates.iter().any(|c| DYNAMIC.contains(&c.as_str())) || problem.recordings.is_empty() {
+        return Ok(starts);
+    }
+    let ctx = Context::of(problem, none, 0)?;
+    if ctx.n < 20 {
+        return Ok(starts);
+    }
+    let found = scores(&ctx, 0.0).fingerprints;
+    let best = |kind: &dyn Fn(&Fingerprint) -> bool| {
+        found
+            .iter()
+            .map(|e| &e.fingerprint)
+            .filter(|f| kind(f))
+            .max_by(|a, b| a.score().total_cmp(&b.score()))
+            .cloned()
+    };
+    let key = |term: &str, p: &str| ParamId::of_term(term, p).to_string();
+    if let Some(Fingerprint::Delay { seconds, .. }) =
+        best(&|f| matches!(f, Fingerprint::Delay { .. }))
+    {
+        starts.values.insert(key("input_delay", "tau"), seconds);
+    }
+    if let Some(Fingerprint::Lag {
+        channel, seconds, ..
+    }) = best(&|f| matches!(f, Fingerprint::Lag { .. }))
+        && let Some(index) = ["I", "omega"].iter().position(|c| *c == channel)
+        && let Some(Ok(term)) = Term::from_name("sensor_lag", &[index as f64])
+    {
+        starts.values.insert(key("sensor_lag", "tau"), seconds);
+        starts.terms.push(term);
+    }
+    if let Some(Fingerprint::Oscillation {
+        frequency_hz,
+        damping_ratio,
+        grid_points,
+        ..
+    }) = best(&|f| matches!(f, Fingerprint::Oscillation { ringing: true, .. }))
+    {
+        starts
+            .values
+            .insert(key("compliant_coupling", "f_r"), frequency_hz);
+        starts.values.insert(
+            key("compliant_coupling", "zeta"),
+            damping_ratio.unwrap_or(0.1).clamp(1e-3, 1.0),
+        );
+        starts.search_penalty.insert(
+            "compliant_coupling".into(),
+            (grid_points.max(1) as f64).ln(),
+        );
+    }
+    Ok(starts)
+}
