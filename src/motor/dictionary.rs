@@ -170,3 +170,12 @@ pub fn index_of(key: &str) -> Result<usize, String> {
         })?;
     Ok(b * N_FUNCTIONS + f)
 }
+
+/// A function's name as the report prints it: ω, θ and I·|I| for omega, theta and I*|I|.
+pub fn pretty(name: &str) -> String {
+    name.replace("omega_s", "ω_s")
+        .replace("omega", "ω")
+        .replace("theta", "θ")
+        .replace("2*pi*f*t", "2πft")
+        .replace('*', "·")
+}
