@@ -161,16 +161,23 @@ pub fn equation_with(balance: &str, terms: &[(String, f64, Option<(f64, f64)>)])
     } else {
         "J dω/dt"
     };
-    let parts: Vec<String> = terms
-        .iter()
-        .map(|(name, c, interval)| {
-            let band = interval.map_or(String::new(), |(lo, hi)| {
-                format!(" [95%: {}, {}]", signed(lo), signed(hi))
-            });
-            format!("{}·{}{band}", signed(*c), dictionary::pretty(name))
-        })
-        .collect();
-    format!("{lhs} += {}", parts.join(" + "))
+    let mut text = format!("{lhs} +=");
+    for (i, (name, c, interval)) in terms.iter().enumerate() {
+        let band = interval.map_or(String::new(), |(lo, hi)| {
+            format!(" [95%: {}, {}]", signed(lo), signed(hi))
+        });
+        // The first coefficient carries its sign; later ones are joined by it.
+        let (joint, value) = match (i, *c < 0.0) {
+            (0, _) => (" ", signed(*c)),
+            (_, true) => (" − ", signed(-c)),
+            (_, false) => (" + ", signed(*c)),
+        };
+        text.push_str(&format!(
+            "{joint}{value}·{}{band}",
+            dictionary::pretty(name)
+        ));
+    }
+    text
 }
 
 fn equation(balance: &str, functions: &[LawFunction]) -> String {
@@ -181,13 +188,50 @@ fn equation(balance: &str, functions: &[LawFunction]) -> String {
     equation_with(balance, &terms)
 }
 
-/// A number with a true minus sign, four significant digits.
+/// A number to three significant digits with a true minus sign: positional from 10⁻³ to 10⁴
+/// (trailing zeros dropped), else in e-notation.
 fn signed(v: f64) -> String {
-    let text = format!("{v:.4}");
-    let text = if v != 0.0 && (v.abs() < 1e-3 || v.abs() >= 1e4) {
-        format!("{v:.3e}")
+    let text = if v == 0.0 || !v.is_finite() {
+        format!("{v}")
+    } else if v.abs() < 1e-3 || v.abs() >= 1e4 {
+        format!("{v:.2e}")
     } else {
-        text
+        let decimals = (2 - v.abs().log10().floor() as i32).max(0) as usize;
+        let fixed = format!("{v:.decimals$}");
+        if fixed.contains('.') {
+            fixed
+                .trim_end_matches('0')
+                .trim_end_matches('.')
+                .to_string()
+        } else {
+            fixed
+        }
     };
-    text.replacen('-', "−", 1)
+    match text.strip_prefix('-') {
+        Some(magnitude) => format!("−{magnitude}"),
+        None => text,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_law_reads_as_its_equation() {
+        let law = [
+            (
+                "sign(omega)*|I|".to_string(),
+                -0.012,
+                Some((-0.0131, -0.0109)),
+            ),
+            ("omega".to_string(), -2.5e-5, None),
+            ("sin(theta)".to_string(), 0.25, None),
+        ];
+        assert_eq!(
+            equation_with("torque", &law),
+            "J dω/dt += −0.012·sign(ω)·|I| [95%: −0.0131, −0.0109] − 2.50e-5·ω + 0.25·sin(θ)"
+        );
+        assert!(equation_with("voltage", &law[2..]).starts_with("L dI/dt += 0.25·sin(θ)"));
+    }
 }
