@@ -313,6 +313,13 @@ pub fn format_diagnosis(d: &Diagnosis) -> String {
         );
     } else {
         let _ = writeln!(s, "the model lacks {}", d.selected_set.join(" + "));
+        if let Some(law) = &d.discovered {
+            let _ = writeln!(
+                s,
+                "discovered law ({:+.1} nats): {}",
+                law.score, law.equation
+            );
+        }
         if d.fit_after.is_none() {
             let _ = writeln!(s, "its MAP:");
             for (name, value) in &d.selected_params {

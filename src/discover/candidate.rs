@@ -17,6 +17,7 @@ use std::collections::BTreeMap;
 use crate::bayes::{CalibrationPosterior, ModelSettings};
 use crate::density::LogDensity;
 use crate::error::Error;
+use crate::io::CalibrateEntry;
 use crate::motor::Term;
 use crate::optimize::{MapEstimate, MapSettings, find_map};
 use crate::parameter::{ParamId, Support};
@@ -132,6 +133,18 @@ pub fn fit_candidate_started(
             && let Some(set) = starts.terms.iter().find(|t| t.name() == name)
         {
             active.term = set.clone();
+            // What these settings let be calibrated (a law's functions), with default priors.
+            if let Some(calibrate) = &mut problem.model.calibrate {
+                calibrate.retain(|e| !e.id.is_of(name));
+                for p in set.params() {
+                    if set.check_calibrated(p.key).is_ok() {
+                        calibrate.push(CalibrateEntry {
+                            id: ParamId::of_term(name, p.key),
+                            prior: None,
+                        });
+                    }
+                }
+            }
         }
     }
     let mut start = starts.values.clone();

@@ -18,7 +18,7 @@ use super::Progress;
 use super::candidate::{Candidate, Confirmation, answer_params};
 use super::coincide::InputCoincidence;
 use super::fits::{self, Convergence, FitSummary, Mismatch, SampledFit};
-use super::named::fit_named_terms;
+use super::named::{Discovered, discovered, fit_named_terms};
 use super::screen::collinear_pairs;
 use super::selection::Selection;
 use super::settings::{
@@ -82,9 +82,8 @@ pub struct Diagnosis {
     pub notes: Vec<String>,
     /// Structure the selected model leaves that no library term holds (`unexplained`).
     pub unexplained: Option<Unexplained>,
-    /// The law term discovered from a state fingerprint, when one was added (not yet built:
-    /// always null).
-    pub discovered: Option<serde_json::Value>,
+    /// The law term discovered from a state or drift fingerprint, when one was added.
+    pub discovered: Option<Discovered>,
     /// True whenever `unexplained` is not null, or δ's band after the selected terms still
     /// excludes zero on a stretch of the record.
     pub residual_mismatch: bool,
@@ -201,6 +200,7 @@ pub fn assemble(
     // asked again after it.
     let mut left = unexplained(problem, &selected_fit, &none)?;
     let mut ranking = ranking;
+    let mut found = None;
     if let Some(verdict) = &left
         && let Some(fit) = fit_named_terms(
             problem,
@@ -210,6 +210,7 @@ pub fn assemble(
             settings.candidates.as_deref(),
         )?
     {
+        found = discovered(&fit, fit.score - selected_fit.score);
         selected_set = fit.added.clone();
         selected_fit = fit;
         if selected_fit.added.len() == 1 {
@@ -235,7 +236,13 @@ pub fn assemble(
     let mut notes = Vec::new();
     let mut ties = Vec::new();
     let mut tie_experiments = BTreeMap::new();
-    if let Some(first) = ranking.iter().find(|f| f.added.first() == Some(&selected)) {
+    // A discovered law has no rival in the library to be tied with: the ties are the
+    // library's.
+    if let Some(first) = ranking
+        .iter()
+        .find(|f| f.added.first() == Some(&selected))
+        .filter(|_| selected != "law")
+    {
         let noise = first.noise_sd();
         for other in &ranking {
             let Some(name) = other.added.first() else {
@@ -332,7 +339,7 @@ pub fn assemble(
         notes,
         residual_mismatch: left.is_some(),
         unexplained: left,
-        discovered: None,
+        discovered: found,
         convergence: BTreeMap::new(),
         threshold: EVIDENCE_THRESHOLD,
         units: parameter_units(&selected_fit.problem)?,
@@ -452,6 +459,9 @@ fn sampled_fits(
                 .sum::<usize>(),
             LAPLACE_DRAWS
         ));
+    }
+    if let (Some(law), Some(after)) = (&mut diagnosis.discovered, &diagnosis.fit_after) {
+        law.from_sampled(&after.params_mean, &after.params_95);
     }
     // The posterior means as the model file's values.
     let mut model = after_problem.model.clone();

@@ -1,24 +1,29 @@
 //! The dynamic term a fingerprint names, fitted from the fingerprint's estimate: a delay names
 //! `input_delay` (τ), a lag names `sensor_lag` on its channel (τ), a resonance that rings after
 //! the input steps names `compliant_coupling` (f_r and ζ; the load's share from several
-//! starts). These terms are not screened with the library (`PhysicsTerm::SCREENED`):
-//! from a flat start their MAP search rarely finds the valley, from the fingerprint's it does.
+//! starts); a state or drift fingerprint names the `law` with its functions. The dynamic terms
+//! are also ranked with the library (started from the same estimates, `unexplained::starts`);
+//! this is the second chance for what the selected model still leaves.
 //!
 //! Each is tried beside the selected terms and alone (a library term selected for a delay
 //! absorbs part of it, and beside the delay is then dead weight), scored as every candidate is
 //! (log L̂ − ½·d·ln N), and taken when the better of the two beats the selected model by more
 //! than [`EVIDENCE_THRESHOLD`]: the ranking's rule, for the ranking's reason.
 
+use std::collections::BTreeMap;
+
 use rayon::prelude::*;
+use serde::Serialize;
 
 use crate::error::Error;
 use crate::motor::Term;
+use crate::motor::dictionary::{self, BALANCES, FUNCTIONS, N_FUNCTIONS};
 use crate::parameter::ParamId;
 use crate::study::Problem;
 
 use super::candidate::{Candidate, Starts, fit_candidate_started};
 use super::settings::EVIDENCE_THRESHOLD;
-use super::unexplained::{Fingerprint, Unexplained};
+use super::unexplained::{Fingerprint, Unexplained, equation_with};
 
 /// The term a fingerprint names, with its settings and the parameter values it starts at.
 #[derive(Clone, Debug, PartialEq)]
@@ -59,6 +64,36 @@ pub fn named_term(problem: &Problem, fingerprint: &Fingerprint) -> Option<NamedT
                 ],
             )
         }
+        Fingerprint::State { .. } | Fingerprint::Drift { .. } => {
+            let (balance, functions, omega_s) = match fingerprint {
+                Fingerprint::State {
+                    balance,
+                    functions,
+                    omega_s,
+                    ..
+                } => (balance, functions, *omega_s),
+                Fingerprint::Drift {
+                    balance, functions, ..
+                } => (balance, functions, None),
+                _ => return None,
+            };
+            let Some(Term::Law(law)) = Term::named("law") else {
+                return None;
+            };
+            let b = BALANCES.iter().position(|n| n == balance)?;
+            let mut keys = Vec::new();
+            let mut start = Vec::new();
+            for f in functions {
+                let k = b * N_FUNCTIONS + FUNCTIONS.iter().position(|n| *n == f.name)?;
+                keys.push(k);
+                start.push((law_key(k), f.coefficient));
+            }
+            let mut law = law.with_active(keys);
+            if let Some(w) = omega_s {
+                law.shapes.omega_s = w;
+            }
+            (Term::Law(law), start)
+        }
         _ => return None,
     };
     let present = problem
@@ -71,6 +106,14 @@ pub fn named_term(problem: &Problem, fingerprint: &Fingerprint) -> Option<NamedT
         start,
         search_penalty,
     })
+}
+
+/// The law's parameter key `k` as the term declares it (a static text, as `start` keys are).
+fn law_key(k: usize) -> &'static str {
+    let key = dictionary::key(k);
+    Term::named("law")
+        .and_then(|t| t.params().iter().find(|p| p.key == key).map(|p| p.key))
+        .expect("the law declares every key of the dictionary")
 }
 
 /// `named` fitted beside `with` (the selected terms, or none), started at `with`'s estimates
@@ -134,4 +177,90 @@ pub fn fit_named_terms(
         .into_iter()
         .filter(|f| f.score - selected.score > EVIDENCE_THRESHOLD)
         .max_by(|a, b| a.score.total_cmp(&b.score)))
+}
+
+/// One function of a discovered law: its coefficient at the MAP and the 95% interval of the
+/// Laplace approximation there (MAP ± 1.96 sd; the coefficients have real support, so the
+/// approximation's coordinate is the coefficient itself).
+#[derive(Clone, Debug, Serialize)]
+pub struct DiscoveredFunction {
+    pub name: String,
+    pub coefficient: f64,
+    pub q025: f64,
+    pub q975: f64,
+}
+
+/// The law term the diagnosis added, as the JSON's `discovered` reports it.
+#[derive(Clone, Debug, Serialize)]
+pub struct Discovered {
+    pub balance: String,
+    pub functions: Vec<DiscoveredFunction>,
+    /// What adding it gained over the model selected before it (nats, the ranking's score).
+    pub score: f64,
+    /// The law as the report prints it, e.g. `J dω/dt += −0.0001·sign(ω)·|I| [95%: …]`.
+    pub equation: String,
+}
+
+/// The law `fit` holds, in the balance whose functions it lists first, with `gained` its
+/// score over the model before it; `None` when it holds none.
+pub fn discovered(fit: &Candidate, gained: f64) -> Option<Discovered> {
+    let law = fit.problem.model.terms.iter().find_map(|t| match &t.term {
+        Term::Law(law) => Some(law),
+        _ => None,
+    })?;
+    let first = *law.active.first()?;
+    let balance = first / N_FUNCTIONS;
+    let sds = fit.map.laplace_sd();
+    let mut functions = Vec::new();
+    for &k in law.active.iter().filter(|&&k| k / N_FUNCTIONS == balance) {
+        let name = format!("law.{}", dictionary::key(k));
+        let i = fit
+            .posterior
+            .calibrated()
+            .iter()
+            .position(|c| c.name == name)?;
+        let value = *fit.theta.get(&name)?;
+        let half = 1.96 * sds[i];
+        functions.push(DiscoveredFunction {
+            name: FUNCTIONS[k % N_FUNCTIONS].to_string(),
+            coefficient: value,
+            q025: value - half,
+            q975: value + half,
+        });
+    }
+    let mut law = Discovered {
+        equation: String::new(),
+        balance: BALANCES[balance].to_string(),
+        functions,
+        score: gained,
+    };
+    law.write_equation();
+    Some(law)
+}
+
+impl Discovered {
+    fn write_equation(&mut self) {
+        let terms: Vec<(String, f64, Option<(f64, f64)>)> = self
+            .functions
+            .iter()
+            .map(|f| (f.name.clone(), f.coefficient, Some((f.q025, f.q975))))
+            .collect();
+        self.equation = equation_with(&self.balance, &terms);
+    }
+
+    /// The sampled fit's posterior mean and 95% interval in place of the Laplace ones, where
+    /// the fit holds the coefficient (`mean`, `interval` keyed `law.balance:function`).
+    pub fn from_sampled(
+        &mut self,
+        mean: &BTreeMap<String, f64>,
+        interval: &BTreeMap<String, [f64; 2]>,
+    ) {
+        for f in &mut self.functions {
+            let name = format!("law.{}:{}", self.balance, f.name);
+            if let (Some(&m), Some(&[lo, hi])) = (mean.get(&name), interval.get(&name)) {
+                (f.coefficient, f.q025, f.q975) = (m, lo, hi);
+            }
+        }
+        self.write_equation();
+    }
 }

@@ -65,7 +65,10 @@ pub(super) fn parse_terms(
                 file,
                 locate,
                 &field,
-                format!("unknown term '{name}' (known: {})", Term::NAMES.join(", ")),
+                format!(
+                    "unknown term '{name}' (known: {})",
+                    Term::ALL_NAMES.join(", ")
+                ),
             ));
         };
         let Some(entries) = value.as_table() else {
@@ -78,9 +81,12 @@ pub(super) fn parse_terms(
         };
         let mut values: Vec<f64> = params.iter().map(|p| p.default).collect();
         let mut setting_values: Vec<f64> = settings.iter().map(|s| s.default).collect();
+        // The parameters the table lists: a law's active coefficients.
+        let mut listed = Vec::new();
         for (key, v) in entries {
             let key_field = format!("{field}.{key}");
             let slot = if let Some(i) = params.iter().position(|p| p.key == key) {
+                listed.push(i);
                 &mut values[i]
             } else if let Some(i) = settings.iter().position(|s| s.key == key) {
                 let choices = settings[i].choices;
@@ -102,6 +108,12 @@ pub(super) fn parse_terms(
                     continue;
                 }
                 &mut setting_values[i]
+            } else if name == "law" {
+                // A law's keys are balance:function pairs: say which half is unknown.
+                let why = crate::motor::dictionary::index_of(key)
+                    .err()
+                    .unwrap_or_else(|| format!("unknown key '{key}'"));
+                return Err(error(file, locate, &key_field, format!("term law: {why}")));
             } else {
                 let known: Vec<&str> = params
                     .iter()
@@ -130,9 +142,12 @@ pub(super) fn parse_terms(
                 }
             }
         }
-        let term = Term::from_name(name, &setting_values)
+        let mut term = Term::from_name(name, &setting_values)
             .expect("declared above")
             .map_err(|e| error(file, locate, &field, e))?;
+        if let Term::Law(law) = term {
+            term = Term::Law(law.with_active(listed));
+        }
         terms.push(ActiveTerm { term, values });
     }
     Ok(terms)
@@ -156,7 +171,7 @@ fn check_parameter_name(name: &ParamId) -> Result<(), String> {
         ParamId::Term { term, key } => match Term::declarations(term) {
             None => Err(format!(
                 "unknown term '{term}' (known: {})",
-                Term::NAMES.join(", ")
+                Term::ALL_NAMES.join(", ")
             )),
             Some((params, _)) if params.iter().any(|p| p.key == key) => Ok(()),
             Some((params, _)) => Err(format!(
@@ -310,6 +325,15 @@ pub(super) fn parse_calibrate(
                 Term::named(term).expect("checked above"),
             ));
         }
+        // A law coefficient named here is one of the law's functions, listed or not.
+        if let Some(active) = terms.iter_mut().find(|t| name.is_of(t.term.name()))
+            && let Term::Law(law) = &active.term
+            && let Ok(k) = crate::motor::dictionary::index_of(name.key())
+        {
+            let mut keys = law.active.clone();
+            keys.push(k);
+            active.term = Term::Law(law.clone().with_active(keys));
+        }
         entries.push(CalibrateEntry { id: name, prior });
     }
     Ok(entries)
@@ -381,8 +405,17 @@ pub(super) fn write_tables(
 ) {
     for t in terms {
         let _ = writeln!(out, "\n[terms.{}]", t.term.name());
-        for (decl, v) in t.term.params().iter().zip(&t.values) {
-            let _ = writeln!(out, "{} = {}", decl.key, toml_number(*v));
+        for (k, (decl, v)) in t.term.params().iter().zip(&t.values).enumerate() {
+            match &t.term {
+                // A law writes its active coefficients alone, keyed "balance:function".
+                Term::Law(law) if law.active.contains(&k) => {
+                    let _ = writeln!(out, "\"{}\" = {}", decl.key, toml_number(*v));
+                }
+                Term::Law(_) => {}
+                _ => {
+                    let _ = writeln!(out, "{} = {}", decl.key, toml_number(*v));
+                }
+            }
         }
         for (decl, v) in t.term.setting_decls().iter().zip(t.term.settings()) {
             match decl.choices.get(v as usize) {

@@ -41,6 +41,9 @@ pub struct Site<'a, D> {
     pub segment_start: f64,
     pub current: D,
     pub speed: D,
+    /// The supply voltage U as the terms' `input` hooks leave it (zero on a drive base, which
+    /// has none).
+    pub voltage: D,
     /// The constants as the terms' `adjust` left them (J is the rotor's own inertia when a
     /// term moves part of it behind a spring).
     pub coefficients: &'a Coefficients<D>,
@@ -144,6 +147,7 @@ impl MotorModel {
                     segment_start: times[i],
                     current: input[i],
                     speed: speed[i],
+                    voltage: 0.0,
                     coefficients: &c,
                     params: &p[self.param_offsets[k]..self.param_offsets[k + 1]],
                     states: &[],

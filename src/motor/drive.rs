@@ -128,6 +128,7 @@ impl<D: Scalar> HeldInputSystem<D> for Mechanics<'_, D> {
             segment_start: t,
             current: input,
             speed,
+            voltage: D::from(0.0),
             coefficients: c,
             params: &self.p[model.param_offsets[k]..model.param_offsets[k + 1]],
             states: &y[model.state_offsets[k]..model.state_offsets[k + 1]],

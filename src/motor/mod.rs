@@ -10,6 +10,7 @@
 mod balance;
 mod base;
 pub mod closed_form;
+pub mod dictionary;
 mod drive;
 mod input;
 mod magnitudes;

@@ -83,6 +83,7 @@ impl<D: Scalar> MotorSystem<'_, D> {
             segment_start,
             current,
             speed,
+            voltage,
             coefficients: c,
             params: params(k),
             states: &y[model.state_offsets[k]..model.state_offsets[k + 1]],

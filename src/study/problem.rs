@@ -195,7 +195,12 @@ impl Problem {
                     Term::NAMES.join(", ")
                 ))
             })?;
-            for p in term.params() {
+            // Only what the term's settings let be calibrated: a law's listed coefficients.
+            for p in term
+                .params()
+                .iter()
+                .filter(|p| term.check_calibrated(p.key).is_ok())
+            {
                 calibrate.push(CalibrateEntry {
                     id: ParamId::of_term(name, p.key),
                     prior: None,

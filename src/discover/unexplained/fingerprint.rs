@@ -3,6 +3,17 @@
 
 use serde::Serialize;
 
+use crate::motor::dictionary;
+
+/// One function of a state fingerprint: its dictionary name, the coefficient the linearised
+/// regression gives (the physical unit of the law's coefficient) and its sd.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct LawFunction {
+    pub name: String,
+    pub coefficient: f64,
+    pub sd: f64,
+}
+
 /// The leading kinds of structure left, each with its own score (nats over the model).
 #[derive(Clone, Debug, Serialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
@@ -29,6 +40,25 @@ pub enum Fingerprint {
         sd: f64,
         score: f64,
     },
+    /// The balance (`torque`, `voltage`) misses a sum of dictionary functions of the state.
+    State {
+        balance: String,
+        functions: Vec<LawFunction>,
+        /// The Stribeck speed ω_s of `exp(-(omega/omega_s)^2)*sign(omega)`, where it is one
+        /// of the functions.
+        #[serde(skip_serializing_if = "Option::is_none")]
+        omega_s: Option<f64>,
+        score: f64,
+    },
+    /// The balance drifts with time, the charge drawn or the heat dissipated: a state set of
+    /// `t`, `charge` or `heat` alone.
+    Drift {
+        /// `time`, `charge` or `heat`: the first function selected.
+        variable: String,
+        balance: String,
+        functions: Vec<LawFunction>,
+        score: f64,
+    },
     Unknown {
         score: f64,
     },
@@ -40,6 +70,8 @@ impl Fingerprint {
             Fingerprint::Oscillation { score, .. }
             | Fingerprint::Delay { score, .. }
             | Fingerprint::Lag { score, .. }
+            | Fingerprint::State { score, .. }
+            | Fingerprint::Drift { score, .. }
             | Fingerprint::Unknown { score } => *score,
         }
     }
@@ -53,6 +85,8 @@ impl Fingerprint {
             } => format!("oscillation/{channel}/{ringing}"),
             Fingerprint::Delay { .. } => "delay".into(),
             Fingerprint::Lag { channel, .. } => format!("lag/{channel}"),
+            Fingerprint::State { balance, .. } => format!("state/{balance}"),
+            Fingerprint::Drift { .. } => "drift".into(),
             Fingerprint::Unknown { .. } => "unknown".into(),
         }
     }
@@ -94,11 +128,113 @@ impl Fingerprint {
                  sensor or logger (the term sensor_lag on {channel})",
                 seconds * 1e3
             ),
+            Fingerprint::State {
+                balance, functions, ..
+            } => format!(
+                "the {balance} balance follows the state: {} fits what is left (the term \
+                 law); a record with another input would confirm the law beyond this one's \
+                 states",
+                equation(balance, functions)
+            ),
+            Fingerprint::Drift {
+                variable,
+                balance,
+                functions,
+                ..
+            } => format!(
+                "the {balance} balance drifts with the {variable}: {} fits what is left (the \
+                 term law): a supply that sags with the charge drawn, a resistance or a \
+                 constant that changes as the motor warms, or a slow change in time",
+                equation(balance, functions)
+            ),
             Fingerprint::Unknown { .. } => format!(
                 "structure no library term holds remains in {}: a record with another input \
                  (a reversal, steps of several sizes) would show how it depends on the state",
                 channels.join(" and ")
             ),
         }
+    }
+}
+
+/// A balance's law as an equation, e.g. `J dω/dt += −0.012·sign(ω)·|I|`, each function with
+/// its coefficient and, where given, an interval after it.
+pub fn equation_with(balance: &str, terms: &[(String, f64, Option<(f64, f64)>)]) -> String {
+    let lhs = if balance == "voltage" {
+        "L dI/dt"
+    } else {
+        "J dω/dt"
+    };
+    let mut text = format!("{lhs} +=");
+    for (i, (name, c, interval)) in terms.iter().enumerate() {
+        let band = interval.map_or(String::new(), |(lo, hi)| {
+            format!(" [95%: {}, {}]", signed(lo), signed(hi))
+        });
+        // The first coefficient carries its sign; later ones are joined by it.
+        let (joint, value) = match (i, *c < 0.0) {
+            (0, _) => (" ", signed(*c)),
+            (_, true) => (" − ", signed(-c)),
+            (_, false) => (" + ", signed(*c)),
+        };
+        text.push_str(&format!(
+            "{joint}{value}·{}{band}",
+            dictionary::pretty(name)
+        ));
+    }
+    text
+}
+
+fn equation(balance: &str, functions: &[LawFunction]) -> String {
+    let terms: Vec<(String, f64, Option<(f64, f64)>)> = functions
+        .iter()
+        .map(|f| (f.name.clone(), f.coefficient, None))
+        .collect();
+    equation_with(balance, &terms)
+}
+
+/// A number to three significant digits with a true minus sign: positional from 10⁻³ to 10⁴
+/// (trailing zeros dropped), else in e-notation.
+fn signed(v: f64) -> String {
+    let text = if v == 0.0 || !v.is_finite() {
+        format!("{v}")
+    } else if v.abs() < 1e-3 || v.abs() >= 1e4 {
+        format!("{v:.2e}")
+    } else {
+        let decimals = (2 - v.abs().log10().floor() as i32).max(0) as usize;
+        let fixed = format!("{v:.decimals$}");
+        if fixed.contains('.') {
+            fixed
+                .trim_end_matches('0')
+                .trim_end_matches('.')
+                .to_string()
+        } else {
+            fixed
+        }
+    };
+    match text.strip_prefix('-') {
+        Some(magnitude) => format!("−{magnitude}"),
+        None => text,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_law_reads_as_its_equation() {
+        let law = [
+            (
+                "sign(omega)*|I|".to_string(),
+                -0.012,
+                Some((-0.0131, -0.0109)),
+            ),
+            ("omega".to_string(), -2.5e-5, None),
+            ("sin(theta)".to_string(), 0.25, None),
+        ];
+        assert_eq!(
+            equation_with("torque", &law),
+            "J dω/dt += −0.012·sign(ω)·|I| [95%: −0.0131, −0.0109] − 2.50e-5·ω + 0.25·sin(θ)"
+        );
+        assert!(equation_with("voltage", &law[2..]).starts_with("L dI/dt += 0.25·sin(θ)"));
     }
 }

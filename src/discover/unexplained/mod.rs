@@ -29,6 +29,7 @@ mod fingerprint;
 mod oscillation;
 mod regression;
 mod starts;
+mod state;
 mod step_screen;
 mod timing;
 
@@ -43,7 +44,7 @@ use super::candidate::Candidate;
 use super::coincide::input_steps;
 use super::fits::MISMATCH_MIN_SHARE;
 use super::settings::EVIDENCE_THRESHOLD;
-pub use fingerprint::Fingerprint;
+pub use fingerprint::{Fingerprint, equation_with};
 use oscillation::Oscillation;
 use regression::{Explained, Projector, explain};
 pub use starts::{DYNAMIC, dynamic_starts};
@@ -398,12 +399,19 @@ pub fn unexplained(
         return Ok(None);
     }
     let mut all = scores(&ctx, 0.0);
+    all.fingerprints
+        .extend(state::fingerprints(selected, &ctx, 0.0)?);
     if !selected.added.is_empty() {
         // What the selected terms gained over the model as given is the bar an alternative on
-        // the model as given must clear to count against them.
+        // the model as given must clear to count against them. A law a library term absorbs
+        // almost whole (Stribeck friction taken as Coulomb friction, a supply that sags with
+        // the charge taken as a back-EMF constant) shows best there.
+        let shift = selected.score - none.score;
         let none_ctx = Context::of(problem, none, 0)?;
-        let on_none = scores(&none_ctx, selected.score - none.score);
+        let on_none = scores(&none_ctx, shift);
         all.fingerprints.extend(on_none.fingerprints);
+        all.fingerprints
+            .extend(state::fingerprints(none, &none_ctx, shift)?);
     }
     let best_generic = all
         .generic

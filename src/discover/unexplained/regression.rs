@@ -78,6 +78,14 @@ pub fn gain(y: &DVector<f64>, b: &DMatrix<f64>) -> f64 {
     0.5 * h.dot(&(&g_inv * &h))
 }
 
+/// The sds of the coefficients of B̃'s columns (σ = 1 in whitened units): √diag((B̃ᵀB̃)⁺).
+pub fn coefficient_sds(b_tilde: &DMatrix<f64>) -> Vec<f64> {
+    let (g_inv, _) = pseudo_inverse(b_tilde.transpose() * b_tilde);
+    (0..g_inv.nrows())
+        .map(|i| g_inv[(i, i)].max(0.0).sqrt())
+        .collect()
+}
+
 /// Regress y on B̃ (already residualized against the model).
 pub fn explain(y: &DVector<f64>, b_tilde: &DMatrix<f64>) -> Explained {
     let h = b_tilde.transpose() * y;

@@ -159,7 +159,13 @@ pub(crate) fn positive(_: &Magnitudes) -> Support {
 // leaves the term files as they are: format them with
 // `rustfmt --edition 2024 src/motor/terms/*.rs`.
 macro_rules! terms {
-    ($($module:ident::$variant:ident),* $(,)?) => {
+    // The library, then the terms beyond it (`;`): every term reads and writes alike, but only
+    // the library's are named in `Term::NAMES`, the list diagnose screens and the case
+    // generators draw effects from.
+    ($($module:ident::$variant:ident),* $(,)? ; $($beyond:ident::$bvariant:ident),* $(,)?) => {
+        terms!(@all [$($module::$variant),* , $($beyond::$bvariant),*] [$($variant),*]);
+    };
+    (@all [$($module:ident::$variant:ident),*] [$($library:ident),*]) => {
         $(
             mod $module;
             pub use $module::$variant;
@@ -172,8 +178,13 @@ macro_rules! terms {
         }
 
         impl Term {
-            /// Every term's name, in the canonical order in which models list them.
-            pub const NAMES: &'static [&'static str] = &[$(<$variant as PhysicsTerm>::NAME),*];
+            /// The library's terms, in the canonical order in which models list them: what
+            /// diagnose ranks and the case generators draw effects from.
+            pub const NAMES: &'static [&'static str] = &[$(<$library as PhysicsTerm>::NAME),*];
+
+            /// Every term a model file can name, the library's first: the canonical order.
+            pub const ALL_NAMES: &'static [&'static str] =
+                &[$(<$variant as PhysicsTerm>::NAME),*];
 
             /// A term by name with its settings (`None` for an unknown name).
             pub fn from_name(name: &str, settings: &[f64]) -> Option<Result<Term, String>> {
@@ -196,9 +207,9 @@ macro_rules! terms {
                 None
             }
 
-            /// Place in [`Term::NAMES`].
+            /// Place in [`Term::ALL_NAMES`].
             pub fn rank(&self) -> usize {
-                Self::NAMES.iter().position(|n| *n == self.name()).unwrap_or(usize::MAX)
+                Self::ALL_NAMES.iter().position(|n| *n == self.name()).unwrap_or(usize::MAX)
             }
 
             pub fn name(&self) -> &'static str {
@@ -301,7 +312,10 @@ terms!(
     sensor_lag::SensorLag,
     current_offset::CurrentOffset,
     speed_gain::SpeedGain,
-    asymmetric_friction::AsymmetricFriction,
+    asymmetric_friction::AsymmetricFriction;
+    // Beyond the library: a law of the state written from the dictionary, found by the
+    // unexplained verdict's state fingerprint, never screened.
+    law::Law,
 );
 
 impl Term {

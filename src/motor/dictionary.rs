@@ -1,0 +1,181 @@
+//! The dictionary of functions of the state and the input that a `law` term is written in, and
+//! that the unexplained verdict's state fingerprint regresses the residual on. The names are
+//! fixed ASCII (issue 19), the same in the JSON, the model file and the report.
+//!
+//! A law adds Σ c·f(state, input) to one of the two balances; a coefficient is keyed
+//! `balance:function` (`torque:sign(omega)*|I|`).
+
+use super::{Magnitudes, Scalar};
+
+/// The functions, in the order of the law's parameters (within each balance).
+pub const FUNCTIONS: [&str; 17] = [
+    "omega",
+    "omega*|omega|",
+    "omega^3",
+    "sign(omega)",
+    "exp(-(omega/omega_s)^2)*sign(omega)",
+    "I",
+    "|I|",
+    "I*|I|",
+    "sign(omega)*|I|",
+    "U",
+    "charge",
+    "heat",
+    "t",
+    "sin(theta)",
+    "cos(theta)",
+    "sin(2*pi*f*t)",
+    "cos(2*pi*f*t)",
+];
+
+/// How many functions the dictionary holds.
+pub const N_FUNCTIONS: usize = FUNCTIONS.len();
+
+/// The balances a law adds to, in the order of the law's parameters.
+pub const BALANCES: [&str; 2] = ["torque", "voltage"];
+
+/// Functions that read the law's own states: the charge ∫|I|dt, the heat ∫R·I²dt, the angle
+/// θ = ∫ω dt (in the order of the law's states).
+pub const CHARGE: usize = 10;
+pub const HEAT: usize = 11;
+pub const TIME: usize = 12;
+const SIN_THETA: usize = 13;
+const COS_THETA: usize = 14;
+
+/// The state a function needs integrated (0: charge, 1: heat, 2: θ), if any.
+pub fn state_of(function: usize) -> Option<usize> {
+    match function {
+        CHARGE => Some(0),
+        HEAT => Some(1),
+        SIN_THETA | COS_THETA => Some(2),
+        _ => None,
+    }
+}
+
+/// The fixed shapes of the dictionary: the smoothing speed of sign(ω) (as Coulomb friction
+/// smooths it), the Stribeck speed ω_s and the frequency f of the periodic functions.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Shapes {
+    pub omega_smooth: f64,
+    pub omega_s: f64,
+    pub frequency: f64,
+}
+
+/// Where the functions are evaluated: the state, the input and the law's own states.
+pub struct Point<D> {
+    pub t: f64,
+    pub current: D,
+    pub speed: D,
+    pub voltage: D,
+    pub charge: D,
+    pub heat: D,
+    pub theta: D,
+}
+
+/// Function `f` of the dictionary at `x`.
+pub fn value<D: Scalar>(f: usize, x: &Point<D>, s: &Shapes) -> D {
+    let sign = || super::terms::tanh(x.speed / s.omega_smooth);
+    let phase = 2.0 * std::f64::consts::PI * s.frequency * x.t;
+    match f {
+        0 => x.speed,
+        1 => x.speed * x.speed.abs(),
+        2 => x.speed * x.speed * x.speed,
+        3 => sign(),
+        4 => {
+            let r = x.speed / s.omega_s;
+            (-(r * r)).exp() * sign()
+        }
+        5 => x.current,
+        6 => x.current.abs(),
+        7 => x.current * x.current.abs(),
+        8 => sign() * x.current.abs(),
+        9 => x.voltage,
+        CHARGE => x.charge,
+        HEAT => x.heat,
+        TIME => D::from(x.t),
+        SIN_THETA => x.theta.sin(),
+        COS_THETA => x.theta.cos(),
+        15 => D::from(phase.sin()),
+        16 => D::from(phase.cos()),
+        _ => unreachable!("the dictionary has {N_FUNCTIONS} functions"),
+    }
+}
+
+/// The size function `f` typically takes on this machine and record: a coefficient's prior is
+/// a tenth of its balance's scale divided by it.
+pub fn typical_size(f: usize, m: &Magnitudes) -> f64 {
+    match f {
+        0 => m.speed,
+        1 => m.speed * m.speed,
+        2 => m.speed.powi(3),
+        5 | 6 | 8 => m.current,
+        7 => m.current * m.current,
+        9 => m.voltage,
+        CHARGE => m.current * m.duration,
+        // R·I² over the record: U·I at stall.
+        HEAT => m.voltage * m.current * m.duration,
+        TIME => m.duration,
+        _ => 1.0,
+    }
+}
+
+/// The unit of a coefficient of function `f` in the torque balance and in the voltage balance.
+pub fn units(f: usize) -> (&'static str, &'static str) {
+    match f {
+        0 => ("N·m·s/rad", "V·s/rad"),
+        1 => ("N·m·s²/rad²", "V·s²/rad²"),
+        2 => ("N·m·s³/rad³", "V·s³/rad³"),
+        5 | 6 | 8 => ("N·m/A", "Ω"),
+        7 => ("N·m/A²", "V/A²"),
+        9 => ("N·m/V", "1"),
+        CHARGE => ("N·m/(A·s)", "V/(A·s)"),
+        HEAT => ("N·m/J", "V/J"),
+        TIME => ("N·m/s", "V/s"),
+        _ => ("N·m", "V"),
+    }
+}
+
+/// The coefficient key `balance:function` of parameter `k` of the law.
+pub fn key(k: usize) -> String {
+    format!(
+        "{}:{}",
+        BALANCES[k / N_FUNCTIONS],
+        FUNCTIONS[k % N_FUNCTIONS]
+    )
+}
+
+/// The law's parameter index of a key `balance:function`, or why there is none.
+pub fn index_of(key: &str) -> Result<usize, String> {
+    let Some((balance, function)) = key.split_once(':') else {
+        return Err(format!(
+            "'{key}' is not a law coefficient: write \"balance:function\", the balance one of \
+             {}",
+            BALANCES.join(", ")
+        ));
+    };
+    let b = BALANCES.iter().position(|n| *n == balance).ok_or_else(|| {
+        format!(
+            "'{key}': unknown balance '{balance}' (known: {})",
+            BALANCES.join(", ")
+        )
+    })?;
+    let f = FUNCTIONS
+        .iter()
+        .position(|n| *n == function)
+        .ok_or_else(|| {
+            format!(
+                "'{key}': unknown function '{function}' (the dictionary: {})",
+                FUNCTIONS.join(", ")
+            )
+        })?;
+    Ok(b * N_FUNCTIONS + f)
+}
+
+/// A function's name as the report prints it: ω, θ and I·|I| for omega, theta and I*|I|.
+pub fn pretty(name: &str) -> String {
+    name.replace("omega_s", "ω_s")
+        .replace("omega", "ω")
+        .replace("theta", "θ")
+        .replace("2*pi*f*t", "2πft")
+        .replace('*', "·")
+}

@@ -1,0 +1,217 @@
+//! The law term: each dictionary function's coefficient has the sensitivity finite differences
+//! of the simulated channels give, in either balance; a law holding one library term's shape is
+//! that term (viscous friction, Coulomb friction); a model file with a law reads back as
+//! written, with its active coefficients alone; an unknown function is refused with the file
+//! and the key named.
+
+use motorcal::forward::ForwardModel;
+use motorcal::io::read_model_file;
+use motorcal::motor::dictionary::{self, FUNCTIONS, N_FUNCTIONS};
+use motorcal::motor::{ActiveTerm, MotorModel, MotorParameters, Term, VoltageInput};
+use motorcal::ode::SolverSettings;
+use nalgebra::DMatrix;
+
+fn grid(step: f64, end: f64) -> Vec<f64> {
+    let n = (end / step).round() as usize;
+    (1..=n).map(|i| i as f64 * step).collect()
+}
+
+/// 24 V, 8 V from 0.1 s, −24 V from 0.3 s: the speed reverses, so every sign and |·| is seen
+/// on both sides.
+fn reversal() -> VoltageInput {
+    let times = grid(1e-3, 0.5);
+    let values = times
+        .iter()
+        .map(|&t| match t {
+            t if t < 0.1 => 24.0,
+            t if t < 0.3 => 8.0,
+            _ => -24.0,
+        })
+        .collect();
+    VoltageInput::Held { times, values }
+}
+
+/// The law with the coefficients `active` (parameter indices) at `values` (the others 0).
+fn law(active: &[(usize, f64)]) -> ActiveTerm {
+    let Some(Term::Law(law)) = Term::named("law") else {
+        panic!("law is a term");
+    };
+    let law = law.with_active(active.iter().map(|a| a.0).collect());
+    let mut values = vec![0.0; 2 * N_FUNCTIONS];
+    for &(k, v) in active {
+        values[k] = v;
+    }
+    ActiveTerm {
+        term: Term::Law(law),
+        values,
+    }
+}
+
+fn model(terms: Vec<ActiveTerm>) -> MotorModel {
+    MotorModel::with_terms(MotorParameters::default(), reversal(), terms).unwrap()
+}
+
+fn simulate(terms: Vec<ActiveTerm>) -> Vec<f64> {
+    let fm = ForwardModel::new(
+        model(terms),
+        grid(1e-3, 0.5),
+        &[] as &[&str],
+        SolverSettings::for_data_generation(),
+    )
+    .unwrap();
+    let mut out = vec![0.0; fm.n_outputs()];
+    fm.simulate(&[], &mut out).unwrap();
+    out
+}
+
+fn peak(v: &[f64]) -> f64 {
+    v.iter().fold(0.0f64, |a, x| a.max(x.abs()))
+}
+
+#[test]
+fn the_law_s_parameters_are_the_dictionary_in_each_balance() {
+    let term = Term::named("law").unwrap();
+    let keys: Vec<&str> = term.params().iter().map(|p| p.key).collect();
+    let expected: Vec<String> = (0..2 * N_FUNCTIONS).map(dictionary::key).collect();
+    assert_eq!(keys, expected);
+    assert!(
+        !Term::NAMES.contains(&"law"),
+        "the law is not a library effect"
+    );
+}
+
+/// Every coefficient's dual-number sensitivity against central finite differences, at a value
+/// of a tenth of its prior sd (an effect the record sees, not one that dominates it).
+#[test]
+fn every_coefficient_s_sensitivity_matches_finite_differences() {
+    let magnitudes = model(Vec::new()).magnitudes(0.5);
+    let decls = Term::named("law").unwrap().params();
+    for k in 0..2 * N_FUNCTIONS {
+        let sd = (decls[k].prior)(&magnitudes).variance().sqrt();
+        let theta = 0.1 * sd;
+        let name = format!("law.{}", dictionary::key(k));
+        let fm = ForwardModel::new(
+            model(vec![law(&[(k, theta)])]),
+            grid(1e-3, 0.5),
+            &[name.as_str()],
+            SolverSettings::for_data_generation(),
+        )
+        .unwrap();
+        let n = fm.n_outputs();
+        let (mut out, mut jac) = (vec![0.0; n], DMatrix::zeros(n, 1));
+        fm.simulate_with_sensitivities(&[theta], &mut out, &mut jac)
+            .unwrap();
+        let step = 1e-4 * theta;
+        let (mut plus, mut minus) = (vec![0.0; n], vec![0.0; n]);
+        fm.simulate(&[theta + step], &mut plus).unwrap();
+        fm.simulate(&[theta - step], &mut minus).unwrap();
+        let scale = peak(jac.as_slice());
+        assert!(scale > 0.0, "{name}: the outputs do not depend on it");
+        for i in 0..n {
+            let fd = (plus[i] - minus[i]) / (2.0 * step);
+            assert!(
+                (fd - jac[(i, 0)]).abs() <= 1e-3 * scale,
+                "{name} at {theta}, output {i}: dual {} vs finite difference {fd} (scale \
+                 {scale})",
+                jac[(i, 0)]
+            );
+        }
+    }
+}
+
+/// A law of ω in the torque balance is viscous friction, one of sign(ω) Coulomb friction (the
+/// same smoothing): the same channels to the integrator's tolerance.
+#[test]
+fn a_law_in_a_library_term_s_shape_is_that_term() {
+    let omega = FUNCTIONS.iter().position(|f| *f == "omega").unwrap();
+    let sign = FUNCTIONS.iter().position(|f| *f == "sign(omega)").unwrap();
+    for (k, value, name) in [
+        (omega, -2e-5, "viscous_friction"),
+        (sign, -3e-3, "coulomb_friction"),
+    ] {
+        let library = simulate(vec![ActiveTerm {
+            term: Term::named(name).unwrap(),
+            values: vec![-value],
+        }]);
+        let found = simulate(vec![law(&[(k, value)])]);
+        let plain = simulate(Vec::new());
+        let effect = peak(
+            &library
+                .iter()
+                .zip(&plain)
+                .map(|(a, b)| a - b)
+                .collect::<Vec<_>>(),
+        );
+        let gap = peak(
+            &library
+                .iter()
+                .zip(&found)
+                .map(|(a, b)| a - b)
+                .collect::<Vec<_>>(),
+        );
+        println!("{name}: effect {effect:.3e}, law − term {gap:.3e}");
+        assert!(effect > 1.0, "{name}: the effect is visible");
+        assert!(gap < 1e-6 * effect, "{name}: the law differs by {gap}");
+    }
+}
+
+fn scratch(tag: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("motorcal-law-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join("model.toml")
+}
+
+#[test]
+fn a_model_file_with_a_law_reads_back_as_written() {
+    let path = scratch("roundtrip");
+    let text = "schema = 2\n\n[terms.law]\n\"torque:sign(omega)*|I|\" = -0.012\n\
+                \"voltage:charge\" = 0.0\nomega_s = 30.0\n\n[calibrate]\nR = {}\n\
+                \"law.torque:sign(omega)*|I|\" = {}\n\"law.voltage:charge\" = {}\n";
+    std::fs::write(&path, text).unwrap();
+    let file = read_model_file(&path).unwrap();
+    let Term::Law(law) = &file.terms[0].term else {
+        panic!("the law is read");
+    };
+    let expected: Vec<usize> = ["torque:sign(omega)*|I|", "voltage:charge"]
+        .iter()
+        .map(|k| dictionary::index_of(k).unwrap())
+        .collect();
+    assert_eq!(law.active, expected);
+    assert_eq!(law.shapes.omega_s, 30.0);
+    let written = motorcal::io::to_toml_string(&file);
+    assert!(
+        written.contains("\"torque:sign(omega)*|I|\" = -0.012"),
+        "{written}"
+    );
+    // A listed coefficient at zero is active still; an unlisted one is not written.
+    assert!(written.contains("\"voltage:charge\" = 0.0"), "{written}");
+    assert!(!written.contains("\"torque:omega\""), "{written}");
+    std::fs::write(&path, &written).unwrap();
+    assert_eq!(read_model_file(&path).unwrap(), file);
+    // A model of the file calibrates the listed coefficients and refuses an unlisted one.
+    let m = file.model(reversal()).unwrap();
+    let times = grid(1e-3, 0.5);
+    let calibrated = ["law.torque:sign(omega)*|I|", "law.voltage:charge"];
+    assert!(ForwardModel::new(m.clone(), times.clone(), &calibrated, Default::default()).is_ok());
+    let e = ForwardModel::new(m, times, &["law.torque:omega"], Default::default()).unwrap_err();
+    assert!(e.contains("not one of the law's functions"), "{e}");
+}
+
+#[test]
+fn an_unknown_function_is_refused_naming_the_file_and_the_key() {
+    let path = scratch("unknown");
+    for (key, why) in [
+        ("torque:sign(theta)", "unknown function 'sign(theta)'"),
+        ("force:omega", "unknown balance 'force'"),
+        ("omega", "write \"balance:function\""),
+    ] {
+        std::fs::write(&path, format!("schema = 2\n[terms.law]\n\"{key}\" = 1.0\n")).unwrap();
+        let e = read_model_file(&path).unwrap_err().to_string();
+        assert!(
+            e.contains(&path.display().to_string())
+                && e.contains(&format!("terms.law.{key}"))
+                && e.contains(why),
+            "{key}: {e}"
+        );
+    }
+}

@@ -1,0 +1,132 @@
+//! Discovering the law: effects no library term holds, simulated outside the crate's model by
+//! the independent RK4 integrator of `examples/beyond_library_cases.rs` (seeds 510012 and
+//! 510015 of `--per-effect 2 --seed-base 510000`, the answer beside each recording), leave a
+//! state fingerprint; the law term written from it is fitted, taken by the ranking's threshold,
+//! and holds the true functions with coefficients near the truth, leaving nothing. Null
+//! records of the crate's own generator, with every candidate allowed, discover nothing.
+
+use std::path::{Path, PathBuf};
+
+use motorcal::discover::{Diagnosis, DiscoverSettings, discover};
+use motorcal::study::cases::{CaseOptions, make_case};
+use motorcal::study::{InputProfile, Problem};
+
+fn settings() -> DiscoverSettings {
+    let mut s = DiscoverSettings {
+        rank_only: true,
+        ..DiscoverSettings::default()
+    };
+    s.run.quiet = true;
+    s
+}
+
+fn fixture(name: &str) -> (Problem, serde_json::Value) {
+    let dir: PathBuf = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fixtures/beyond")
+        .join(name);
+    let problem =
+        Problem::from_files(&[dir.join("recording.csv")], &dir.join("motor.toml")).unwrap();
+    let answer =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("answer.json")).unwrap()).unwrap();
+    (problem, answer)
+}
+
+/// A number of the truth's debug text, e.g. `mu` of `LoadFriction { mu: 0.00016 }`.
+fn truth_value(answer: &serde_json::Value, key: &str) -> f64 {
+    let text = answer["truth"].as_str().unwrap();
+    let at = text.find(&format!("{key}: ")).unwrap() + key.len() + 2;
+    text[at..]
+        .split([',', ' ', '}'])
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap()
+}
+
+fn diagnose(problem: &Problem) -> Diagnosis {
+    let d = discover(problem, &settings()).unwrap();
+    eprintln!(
+        "selected {:?}; discovered {}; unexplained {}",
+        d.selected_set,
+        serde_json::to_string(&d.discovered).unwrap(),
+        serde_json::to_string(&d.unexplained).unwrap()
+    );
+    d
+}
+
+fn within(estimate: f64, truth: f64, share: f64) -> bool {
+    (estimate / truth - 1.0).abs() <= share
+}
+
+/// Friction that grows with the transmitted torque, μ·|I|·tanh(ω), on a record that reverses:
+/// the law −μ·sign(ω)·|I| in the torque balance.
+#[test]
+fn friction_growing_with_the_current_is_discovered_as_its_law() {
+    let (problem, answer) = fixture("load_friction-510012");
+    let mu = truth_value(&answer, "mu");
+    let d = diagnose(&problem);
+    let law = d.discovered.expect("a law is discovered");
+    assert_eq!(law.balance, "torque");
+    let names: Vec<&str> = law.functions.iter().map(|f| f.name.as_str()).collect();
+    assert_eq!(names, ["sign(omega)*|I|"]);
+    let f = &law.functions[0];
+    assert!(
+        within(f.coefficient, -mu, 0.3),
+        "{} vs {}",
+        f.coefficient,
+        -mu
+    );
+    assert!(f.q025 < f.coefficient && f.coefficient < f.q975);
+    assert!(law.score > d.threshold);
+    assert!(law.equation.starts_with("J dω/dt += −"), "{}", law.equation);
+    assert!(d.selected_set.iter().any(|t| t == "law"));
+    assert!(d.unexplained.is_none(), "{:?}", d.unexplained);
+}
+
+/// A torque ripple once per revolution, −a·sin(θ + φ): the law in sin θ and cos θ, with the
+/// ripple's amplitude √(c_s² + c_c²) near a.
+#[test]
+fn a_ripple_once_per_revolution_is_discovered_in_the_angle() {
+    let (problem, answer) = fixture("eccentric-510015");
+    let a = truth_value(&answer, "a");
+    let d = diagnose(&problem);
+    let law = d.discovered.expect("a law is discovered");
+    assert_eq!(law.balance, "torque");
+    let mut names: Vec<&str> = law.functions.iter().map(|f| f.name.as_str()).collect();
+    names.sort();
+    assert_eq!(names, ["cos(theta)", "sin(theta)"]);
+    let amplitude = law
+        .functions
+        .iter()
+        .map(|f| f.coefficient * f.coefficient)
+        .sum::<f64>()
+        .sqrt();
+    assert!(within(amplitude, a, 0.3), "{amplitude} vs {a}");
+    assert!(d.unexplained.is_none(), "{:?}", d.unexplained);
+}
+
+/// Null records, every candidate allowed (the law among what may be added): nothing is
+/// discovered and nothing is said to be left.
+#[test]
+fn a_recording_of_the_model_itself_discovers_no_law() {
+    for (seed, input) in [(4, InputProfile::Reversal), (5, InputProfile::Constant)] {
+        let case = make_case(&CaseOptions {
+            effects: vec!["none".into()],
+            magnitude: None,
+            input,
+            seed,
+            conceal: true,
+        })
+        .unwrap();
+        let problem = Problem {
+            label: "null".into(),
+            recordings: vec![case.recording],
+            model: case.nominal,
+            reference: None,
+        };
+        let d = diagnose(&problem);
+        assert!(d.discovered.is_none(), "seed {seed}");
+        assert!(!d.selected_set.iter().any(|t| t == "law"), "seed {seed}");
+        assert!(d.unexplained.is_none(), "seed {seed}");
+    }
+}
