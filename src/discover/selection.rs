@@ -21,16 +21,31 @@ pub fn rank(problem: &Problem, candidates: &[String]) -> Result<Vec<Candidate>, 
     let none = fit_candidate(problem, &[])?;
     let starts = dynamic_starts(problem, &none, candidates)?;
     let mut fits = vec![none];
-    fits.extend(
-        candidates
-            .par_iter()
-            .map(|c| fit_candidate_started(problem, std::slice::from_ref(c), None, &starts))
-            .collect::<Result<Vec<_>, _>>()?,
-    );
+    let fitted = candidates
+        .par_iter()
+        .map(|c| fit_candidate_started(problem, std::slice::from_ref(c), None, &starts))
+        .collect::<Vec<_>>();
+    for (c, fit) in candidates.iter().zip(fitted) {
+        if let Some(fit) = kept(std::slice::from_ref(c), fit)? {
+            fits.push(fit);
+        }
+    }
     // Stable: equal scores keep the candidates' canonical order.
     fits.sort_by(|a, b| b.score.total_cmp(&a.score));
     confirm_leaders(&mut fits)?;
     Ok(fits)
+}
+
+/// A fit, or nothing where a dynamic term's solve could not be completed (a resonance driven
+/// stiff far from the data: the integrator gives up): that candidate is not ranked, as a model
+/// the recording cannot be simulated with explains nothing. Any other failure is the
+/// diagnosis's.
+fn kept(added: &[String], fit: Result<Candidate, Error>) -> Result<Option<Candidate>, Error> {
+    match fit {
+        Ok(f) => Ok(Some(f)),
+        Err(Error::Numerical(_)) if added.iter().any(|a| DYNAMIC.contains(&a.as_str())) => Ok(None),
+        Err(e) => Err(e),
+    }
 }
 
 /// How many leading candidates the sampling check looks at.
@@ -141,6 +156,10 @@ pub fn forward_selection(
         let fits = sets
             .par_iter()
             .map(|added| fit_candidate_started(problem, added, Some(&current), &starts))
+            .collect::<Vec<_>>()
+            .into_iter()
+            .zip(&sets)
+            .filter_map(|(f, added)| kept(added, f).transpose())
             .collect::<Result<Vec<_>, _>>()?;
         let mut next: Option<Candidate> = None;
         let mut confounded: Vec<Candidate> = Vec::new();
