@@ -201,14 +201,15 @@ pub fn assemble(
     let mut left = unexplained(problem, &selected_fit, &none)?;
     let mut ranking = ranking;
     let mut found = None;
+    // A recording that cannot be this motor gets no physics named, by the library or the
+    // fingerprint.
+    let allowed: Option<&[String]> = if settings.implausible.is_empty() {
+        settings.candidates.as_deref()
+    } else {
+        Some(&[])
+    };
     if let Some(verdict) = &left
-        && let Some(fit) = fit_named_terms(
-            problem,
-            verdict,
-            &selected_fit,
-            &none,
-            settings.candidates.as_deref(),
-        )?
+        && let Some(fit) = fit_named_terms(problem, verdict, &selected_fit, &none, allowed)?
     {
         found = discovered(&fit, fit.score - selected_fit.score);
         selected_set = fit.added.clone();
