@@ -86,8 +86,9 @@ fn the_law_s_parameters_are_the_dictionary_in_each_balance() {
 fn every_coefficient_s_sensitivity_matches_finite_differences() {
     let magnitudes = model(Vec::new()).magnitudes(0.5);
     let decls = Term::named("law").unwrap().params();
-    for k in 0..2 * N_FUNCTIONS {
-        let sd = (decls[k].prior)(&magnitudes).variance().sqrt();
+    assert_eq!(decls.len(), 2 * N_FUNCTIONS);
+    for (k, decl) in decls.iter().enumerate() {
+        let sd = (decl.prior)(&magnitudes).variance().sqrt();
         let theta = 0.1 * sd;
         let name = format!("law.{}", dictionary::key(k));
         let fm = ForwardModel::new(

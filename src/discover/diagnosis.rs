@@ -462,7 +462,7 @@ fn sampled_fits(
         ));
     }
     if let (Some(law), Some(after)) = (&mut diagnosis.discovered, &diagnosis.fit_after) {
-        law.from_sampled(&after.params_mean, &after.params_95);
+        law.use_sampled(&after.params_mean, &after.params_95);
     }
     // The posterior means as the model file's values.
     let mut model = after_problem.model.clone();

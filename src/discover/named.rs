@@ -23,7 +23,7 @@ use crate::study::Problem;
 
 use super::candidate::{Candidate, Starts, fit_candidate_started};
 use super::settings::EVIDENCE_THRESHOLD;
-use super::unexplained::{Fingerprint, Unexplained, equation_with};
+use super::unexplained::{EquationTerm, Fingerprint, Unexplained, equation_with};
 
 /// The term a fingerprint names, with its settings and the parameter values it starts at.
 #[derive(Clone, Debug, PartialEq)]
@@ -240,7 +240,7 @@ pub fn discovered(fit: &Candidate, gained: f64) -> Option<Discovered> {
 
 impl Discovered {
     fn write_equation(&mut self) {
-        let terms: Vec<(String, f64, Option<(f64, f64)>)> = self
+        let terms: Vec<EquationTerm> = self
             .functions
             .iter()
             .map(|f| (f.name.clone(), f.coefficient, Some((f.q025, f.q975))))
@@ -250,7 +250,7 @@ impl Discovered {
 
     /// The sampled fit's posterior mean and 95% interval in place of the Laplace ones, where
     /// the fit holds the coefficient (`mean`, `interval` keyed `law.balance:function`).
-    pub fn from_sampled(
+    pub fn use_sampled(
         &mut self,
         mean: &BTreeMap<String, f64>,
         interval: &BTreeMap<String, [f64; 2]>,

@@ -156,9 +156,13 @@ impl Fingerprint {
     }
 }
 
+/// One function of a law as an equation prints it: its dictionary name, its coefficient and,
+/// where given, its 95% interval.
+pub type EquationTerm = (String, f64, Option<(f64, f64)>);
+
 /// A balance's law as an equation, e.g. `J dω/dt += −0.012·sign(ω)·|I|`, each function with
 /// its coefficient and, where given, an interval after it.
-pub fn equation_with(balance: &str, terms: &[(String, f64, Option<(f64, f64)>)]) -> String {
+pub fn equation_with(balance: &str, terms: &[EquationTerm]) -> String {
     let lhs = if balance == "voltage" {
         "L dI/dt"
     } else {
@@ -184,7 +188,7 @@ pub fn equation_with(balance: &str, terms: &[(String, f64, Option<(f64, f64)>)])
 }
 
 fn equation(balance: &str, functions: &[LawFunction]) -> String {
-    let terms: Vec<(String, f64, Option<(f64, f64)>)> = functions
+    let terms: Vec<EquationTerm> = functions
         .iter()
         .map(|f| (f.name.clone(), f.coefficient, None))
         .collect();

@@ -44,7 +44,7 @@ use super::candidate::Candidate;
 use super::coincide::input_steps;
 use super::fits::MISMATCH_MIN_SHARE;
 use super::settings::EVIDENCE_THRESHOLD;
-pub use fingerprint::{Fingerprint, equation_with};
+pub use fingerprint::{EquationTerm, Fingerprint, equation_with};
 use oscillation::Oscillation;
 use regression::{Explained, Projector, explain};
 pub use starts::{DYNAMIC, dynamic_starts};
@@ -296,19 +296,19 @@ fn scores(ctx: &Context, shift: f64) -> Scores {
         // A lag: y_measured ≈ ŷ − τ·dŷ/dt on this channel alone (τ > 0), then fitted exactly.
         let d = DMatrix::from_column_slice(n, 1, &ctx.derivative(c));
         let s = ctx.score(&ctx.in_channel(c, &d), 0.0);
-        if s.explained.coefficients[0] < 0.0 {
-            if let Some(t) = timing::fit(ctx, &ctx.fine, Some(c), -s.explained.coefficients[0]) {
-                fingerprints.push(Evidence {
-                    fingerprint: Fingerprint::Lag {
-                        channel: name,
-                        seconds: t.tau,
-                        sd: t.sd,
-                        score: t.gain - 0.5 * ctx.ln_n - shift,
-                    },
-                    residual: ctx.y.as_slice().to_vec(),
-                    explained: t.change,
-                });
-            }
+        if s.explained.coefficients[0] < 0.0
+            && let Some(t) = timing::fit(ctx, &ctx.fine, Some(c), -s.explained.coefficients[0])
+        {
+            fingerprints.push(Evidence {
+                fingerprint: Fingerprint::Lag {
+                    channel: name,
+                    seconds: t.tau,
+                    sd: t.sd,
+                    score: t.gain - 0.5 * ctx.ln_n - shift,
+                },
+                residual: ctx.y.as_slice().to_vec(),
+                explained: t.change,
+            });
         }
     }
     // A delay: every channel late by the same τ.
@@ -319,18 +319,19 @@ fn scores(ctx: &Context, shift: f64) -> Scores {
         }
     }
     let s = ctx.score(&d, 0.0);
-    if s.explained.coefficients[0] < 0.0 && ctx.channels.len() > 1 {
-        if let Some(t) = timing::fit(ctx, &ctx.fine, None, -s.explained.coefficients[0]) {
-            fingerprints.push(Evidence {
-                fingerprint: Fingerprint::Delay {
-                    seconds: t.tau,
-                    sd: t.sd,
-                    score: t.gain - 0.5 * ctx.ln_n - shift,
-                },
-                residual: ctx.y.as_slice().to_vec(),
-                explained: t.change,
-            });
-        }
+    if s.explained.coefficients[0] < 0.0
+        && ctx.channels.len() > 1
+        && let Some(t) = timing::fit(ctx, &ctx.fine, None, -s.explained.coefficients[0])
+    {
+        fingerprints.push(Evidence {
+            fingerprint: Fingerprint::Delay {
+                seconds: t.tau,
+                sd: t.sd,
+                score: t.gain - 0.5 * ctx.ln_n - shift,
+            },
+            residual: ctx.y.as_slice().to_vec(),
+            explained: t.change,
+        });
     }
     for g in &mut generic {
         g.scored.score -= shift;

@@ -115,7 +115,7 @@ fn law_columns(
         with_law,
         forward.times().to_vec(),
         &names,
-        forward.solver().clone(),
+        *forward.solver(),
     )
     .map_err(Error::invalid)?;
     let mut theta = fit.posterior.theta_of(&fit.map.x);

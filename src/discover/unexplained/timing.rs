@@ -35,7 +35,7 @@ impl FinePrediction {
             forward.model().clone(),
             times.clone(),
             &forward.calibrated_names(),
-            forward.solver().clone(),
+            *forward.solver(),
         )
         .map_err(Error::Numerical)?;
         let mut out = vec![0.0; fine.n_outputs()];
