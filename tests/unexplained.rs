@@ -2,9 +2,9 @@
 //! says so and fingerprints it, instead of "nothing missing found"; where nothing is missing it
 //! stays silent.
 //!
-//! The three effects were simulated outside the crate's model, by the independent fixed-step
-//! Runge–Kutta integrator of `examples/beyond_library_cases.rs` (seeds 510007, 510008, 510018,
-//! the answer beside each recording):
+//! The effects were simulated outside the crate's model, by the independent fixed-step
+//! Runge–Kutta integrator of `examples/beyond_library_cases.rs` (seeds 510007, 510008, 510012,
+//! 510018, the answer beside each recording):
 //!
 //! ```text
 //! cargo run --release --example beyond_library_cases -- --out /tmp/bl --per-effect 2
@@ -180,4 +180,38 @@ fn a_ringing_fingerprint_names_compliant_coupling_and_its_fit_leaves_nothing() {
         "f_r",
         "frequency_hz",
     );
+}
+
+/// Friction growing with the transmitted torque, μ·|I|·tanh(ω), on a record that reverses
+/// (load_friction-510012): no library term holds it, and the state fingerprint names the one
+/// function of the torque balance it follows, sign(ω)·|I|, with a coefficient within three of
+/// its sds of −μ.
+#[test]
+fn friction_growing_with_the_current_is_fingerprinted_as_a_law_of_the_state() {
+    let (problem, answer) = fixture("load_friction-510012");
+    let truth = answer["truth"].as_str().unwrap();
+    let mu: f64 = truth
+        .trim_start_matches("LoadFriction { mu: ")
+        .trim_end_matches(" }")
+        .parse()
+        .unwrap();
+    let u = verdict(&problem).expect("friction no library term holds is not 'nothing missing'");
+    match u.fingerprint {
+        Fingerprint::State {
+            balance, functions, ..
+        } => {
+            assert_eq!(balance, "torque");
+            let names: Vec<&str> = functions.iter().map(|f| f.name.as_str()).collect();
+            assert_eq!(names, ["sign(omega)*|I|"]);
+            let f = &functions[0];
+            assert!(
+                (f.coefficient + mu).abs() < 3.0 * f.sd,
+                "{} ± {} vs {}",
+                f.coefficient,
+                f.sd,
+                -mu
+            );
+        }
+        other => panic!("fingerprint {other:?}"),
+    }
 }
