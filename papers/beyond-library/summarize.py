@@ -28,17 +28,21 @@ for c in sorted(os.listdir(d)):
         return f"{k}: {t.get('variable','')}"
     kind_right = bool(fp) and fp["kind"] == truth["kind"]
     said_nothing = not u and not r["selected_set"]
-    library_alone = not u and bool(r["selected_set"])
+    # The dynamic terms and the law are what a fingerprint names; any other selection with the
+    # verdict null is a library term standing in for the effect.
+    named = {"input_delay", "sensor_lag", "compliant_coupling", "law"}
+    by_fingerprint = any(s in named for s in r["selected_set"])
+    library_alone = not u and bool(r["selected_set"]) and not by_fingerprint
     key = a["effect"]
-    t = tally.setdefault(key, [0, 0, 0, 0])
-    t[0] += 1; t[1] += bool(u); t[2] += kind_right; t[3] += library_alone
+    t = tally.setdefault(key, [0, 0, 0, 0, 0])
+    t[0] += 1; t[1] += bool(u); t[2] += kind_right; t[3] += by_fingerprint; t[4] += library_alone
     rows.append(f"| {c} | {a['type']} | {a['miss_nats']:.0f} | {show_truth(truth)} | {' + '.join(r['selected_set']) or 'none'} | "
                 f"{'%+.1f' % u['evidence'] if u else 'null'} | {show(fp)} | {'nothing missing found' if said_nothing else ''} |")
 print("| case | type | miss (nats) | truth | selected | unexplained | fingerprint | |")
 print("|---|---|---|---|---|---|---|---|")
 print("\n".join(rows))
 print()
-print("| effect | cases | unexplained not null | kind right | a library term alone, verdict null |")
-print("|---|---|---|---|---|")
-for k, (n, u, kr, lib) in sorted(tally.items()):
-    print(f"| {k} | {n} | {u} | {kr} | {lib} |")
+print("| effect | cases | unexplained not null after | its kind right | a dynamic term or law selected | a library term alone, verdict null |")
+print("|---|---|---|---|---|---|")
+for k, (n, u, kr, fp, lib) in sorted(tally.items()):
+    print(f"| {k} | {n} | {u} | {kr} | {fp} | {lib} |")
