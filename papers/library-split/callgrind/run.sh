@@ -11,8 +11,10 @@ root=$(cd "$here/../../.." && pwd)
 old=/tmp/motorcal-ab-old; new=/tmp/motorcal-ab-new
 git -C "$root" worktree add -f --detach "$old" 7ef8f36
 git -C "$root" worktree add -f --detach "$new" "${1:-HEAD}"
-cp "$here/ab_count_old.rs" "$old/examples/ab_count.rs"
-cp "$here/ab_count_new.rs" "$new/examples/ab_count.rs"
+sed 's/^IMPORTS$/use motorcal::app::problem::Problem;\nuse motorcal::app::run::map_estimate;/' \
+  "$here/ab_count.rs" > "$old/examples/ab_count.rs"
+sed 's/^IMPORTS$/use motorcal::pipeline::map_estimate;\nuse motorcal::study::Problem;/' \
+  "$here/ab_count.rs" > "$new/examples/ab_count.rs"
 (cd "$old" && cargo build --release --example ab_count)
 (cd "$new" && cargo build --release --example ab_count)
 echo "k,what,side,instructions" > "$here/counts.csv"

@@ -1,5 +1,6 @@
 //! Instruction counts (under callgrind) of the criterion benches' measured operations, for A/B
-//! between commits: `valgrind --tool=callgrind --collect-atstart=no --toggle-collect='*measured*'`.
+//! between commits (`IMPORTS` is filled in by run.sh: the problem and MAP as each commit
+//! exported them): `valgrind --tool=callgrind --collect-atstart=no --toggle-collect='*measured*'`.
 use std::hint::black_box;
 
 use nalgebra::DMatrix;
@@ -11,8 +12,7 @@ use motorcal::sampler::metric::{Metric, MetricKind};
 use motorcal::sampler::nuts::{Nuts, NutsSettings};
 use motorcal::sampler::{ChainSettings, run_chain};
 use motorcal::synthetic::DEFAULT_SEED;
-use motorcal::app::problem::Problem;
-use motorcal::app::run::map_estimate;
+IMPORTS
 
 #[inline(never)]
 fn measured_density(p: &mut CalibrationPosterior, points: &[Vec<f64>; 3], what: &str, n: usize) {
