@@ -168,6 +168,31 @@ impl Context {
         Scored::new(e, penalty)
     }
 
+    /// Columns `columns` of a forward model's sensitivities (`jacobian`, its outputs channel by
+    /// channel as `simulated` names them), in this context's stacked rows, each channel
+    /// whitened by its σ: regressors for a term the model does not hold yet.
+    pub fn whitened_columns(
+        &self,
+        simulated: &[&str],
+        jacobian: &DMatrix<f64>,
+        columns: &[usize],
+    ) -> Result<DMatrix<f64>, Error> {
+        let n = self.n;
+        let mut b = DMatrix::zeros(self.m(), columns.len());
+        for (c, name) in self.channels.iter().enumerate() {
+            let k = simulated
+                .iter()
+                .position(|f| f == name)
+                .ok_or_else(|| Error::Numerical(format!("channel {name} is not simulated")))?;
+            for i in 0..n {
+                for (j, &p) in columns.iter().enumerate() {
+                    b[(c * n + i, j)] = jacobian[(k * n + i, p)] / self.sigma[c];
+                }
+            }
+        }
+        Ok(b)
+    }
+
     /// Columns `values` (n × d) placed in channel c's rows.
     fn in_channel(&self, c: usize, values: &DMatrix<f64>) -> DMatrix<f64> {
         let mut b = DMatrix::zeros(self.m(), values.ncols());

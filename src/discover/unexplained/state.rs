@@ -125,21 +125,7 @@ fn law_columns(
     lawful
         .simulate_with_sensitivities(&theta, &mut outputs, &mut jacobian)
         .map_err(|e| Error::Numerical(format!("the state fingerprint: {e}")))?;
-    let n = ctx.n;
-    let mut b = DMatrix::zeros(ctx.m(), keys.len());
-    for (c, name) in ctx.channels.iter().enumerate() {
-        let k = lawful
-            .channels()
-            .iter()
-            .position(|f| f == name)
-            .ok_or_else(|| Error::Numerical(format!("channel {name} is not simulated")))?;
-        for i in 0..n {
-            for (j, &slot) in slots.iter().enumerate() {
-                b[(c * n + i, j)] = jacobian[(k * n + i, slot)] / ctx.sigma[c];
-            }
-        }
-    }
-    Ok(b)
+    ctx.whitened_columns(lawful.channels(), &jacobian, &slots)
 }
 
 /// The state and drift fingerprints of `fit` (one per balance that clears the selection), each

@@ -98,20 +98,7 @@ impl StepScreen {
         forward
             .simulate_with_sensitivities(&theta, &mut outputs, &mut jacobian)
             .map_err(|e| Error::Numerical(format!("the step screen: {e}")))?;
-        let n = ctx.n;
-        let mut b = DMatrix::zeros(ctx.m(), new_columns.len());
-        for (c, channel) in ctx.channels.iter().enumerate() {
-            let k = forward
-                .channels()
-                .iter()
-                .position(|f| f == channel)
-                .ok_or_else(|| Error::Numerical(format!("channel {channel} is not simulated")))?;
-            for i in 0..n {
-                for (j, &p) in new_columns.iter().enumerate() {
-                    b[(c * n + i, j)] = jacobian[(k * n + i, p)] / ctx.sigma[c];
-                }
-            }
-        }
+        let b = ctx.whitened_columns(forward.channels(), &jacobian, &new_columns)?;
         let e = explain(&ctx.y, &ctx.projector.residualize(&b));
         Ok(e.gain - 0.5 * new_columns.len() as f64 * ctx.ln_n)
     }
