@@ -89,9 +89,35 @@ struct Whitened<'a, P> {
     origin: Vec<f64>,
     /// L⁻ᵀ
     transform: DMatrix<f64>,
+    /// The gradient in z the last cost call computed, and where. More–Thuente asks for the
+    /// gradient at every point whose cost it asked for, so the cost solves with sensitivities
+    /// once and the gradient call is served from here: one dual-number solve per trial point
+    /// instead of a plain solve followed by a dual-number one.
+    last: RefCell<Option<(Vec<f64>, Vec<f64>)>>,
 }
 
 impl<P: FisherMetric> Whitened<'_, P> {
+    /// log π at z (−∞ outside the support or where the solver gave up) and ∂(−log π)/∂z (zero
+    /// there, so the line search backs off).
+    fn evaluate(&self, z: &[f64]) -> Result<(f64, Vec<f64>), argmin::core::Error> {
+        let x = self.to_x(z);
+        let mut g = vec![0.0; x.len()];
+        match self
+            .density
+            .borrow_mut()
+            .log_density_and_gradient(&x, &mut g)
+        {
+            Ok(lp) if lp.is_finite() => {
+                // ∂(−log π)/∂z = −(L⁻ᵀ)ᵀ ∇ₓ log π
+                let gz = self.transform.tr_mul(&DVector::from_column_slice(&g));
+                Ok((lp, gz.iter().map(|v| -v).collect()))
+            }
+            Ok(_) => Ok((f64::NEG_INFINITY, vec![0.0; x.len()])),
+            Err(e) if e.recoverable => Ok((f64::NEG_INFINITY, vec![0.0; x.len()])),
+            Err(e) => Err(argmin_error(e)),
+        }
+    }
+
     fn to_x(&self, z: &[f64]) -> Vec<f64> {
         let dx = &self.transform * DVector::from_column_slice(z);
         self.origin
@@ -113,13 +139,9 @@ impl<P: FisherMetric> CostFunction for Whitened<'_, P> {
     type Param = Vec<f64>;
     type Output = f64;
     fn cost(&self, z: &Self::Param) -> Result<f64, argmin::core::Error> {
-        let x = self.to_x(z);
-        match self.density.borrow_mut().log_density(&x) {
-            Ok(lp) if lp.is_finite() => Ok(-lp),
-            Ok(_) => Ok(OUTSIDE),
-            Err(e) if e.recoverable => Ok(OUTSIDE),
-            Err(e) => Err(argmin_error(e)),
-        }
+        let (lp, gz) = self.evaluate(z)?;
+        *self.last.borrow_mut() = Some((z.clone(), gz));
+        Ok(if lp.is_finite() { -lp } else { OUTSIDE })
     }
 }
 
@@ -127,21 +149,12 @@ impl<P: FisherMetric> Gradient for Whitened<'_, P> {
     type Param = Vec<f64>;
     type Gradient = Vec<f64>;
     fn gradient(&self, z: &Self::Param) -> Result<Vec<f64>, argmin::core::Error> {
-        let x = self.to_x(z);
-        let mut g = vec![0.0; x.len()];
-        match self
-            .density
-            .borrow_mut()
-            .log_density_and_gradient(&x, &mut g)
+        if let Some((at, gz)) = self.last.borrow().as_ref()
+            && at == z
         {
-            Ok(lp) if lp.is_finite() => {}
-            Ok(_) => return Ok(vec![0.0; x.len()]),
-            Err(e) if e.recoverable => return Ok(vec![0.0; x.len()]),
-            Err(e) => return Err(argmin_error(e)),
+            return Ok(gz.clone());
         }
-        // ∂(−log π)/∂z = −(L⁻ᵀ)ᵀ ∇ₓ log π
-        let gz = self.transform.tr_mul(&DVector::from_column_slice(&g));
-        Ok(gz.iter().map(|v| -v).collect())
+        Ok(self.evaluate(z)?.1)
     }
 }
 
@@ -192,6 +205,7 @@ pub fn find_map<P: FisherMetric>(
             density: RefCell::new(&mut *density),
             origin: x0.clone(),
             transform: l_inv_t,
+            last: RefCell::new(None),
         };
         let linesearch = MoreThuenteLineSearch::new();
         let solver = LBFGS::new(linesearch, 10)
