@@ -293,11 +293,7 @@ fn best_map(
     let mut best: Option<MapEstimate> = None;
     let mut last_error = None;
     for s in starts {
-        let settings = MapSettings {
-            stop_at_rounding: long_record,
-            ..MapSettings::default()
-        };
-        match find_map(posterior, &s, &settings) {
+        match find_map(posterior, &s, &MapSettings::default()) {
             Ok(map) => {
                 if best
                     .as_ref()
