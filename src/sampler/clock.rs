@@ -70,14 +70,23 @@ mod tests {
         let slept = watch.elapsed();
         assert!(slept.wall_seconds >= 0.15, "{slept:?}");
         assert!(slept.cpu_seconds < 0.05, "{slept:?}");
+        // Busy on one thread until it has used 50 ms of CPU: on a loaded machine that takes
+        // longer in wall time (a fixed wall-time loop got 13 ms of CPU in 100 ms here with
+        // four builds beside it), so the loop is bounded by CPU time and, if the clock did
+        // not count, by 10 s of wall time, where the first assertion fails.
         let watch = Stopwatch::start();
         let mut x = 0u64;
-        while watch.elapsed().wall_seconds < 0.1 {
-            x = std::hint::black_box(x.wrapping_mul(6364136223846793005).wrapping_add(1));
-        }
-        let busy = watch.elapsed();
-        // Busy on one thread: CPU time close to wall time (other load can only lower it).
-        assert!(busy.cpu_seconds > 0.02, "{busy:?}");
+        let busy = loop {
+            for _ in 0..10_000 {
+                x = std::hint::black_box(x.wrapping_mul(6364136223846793005).wrapping_add(1));
+            }
+            let e = watch.elapsed();
+            if e.cpu_seconds >= 0.05 || e.wall_seconds > 10.0 {
+                break e;
+            }
+        };
+        assert!(busy.cpu_seconds >= 0.05, "{busy:?}");
+        // CPU time of one thread never exceeds its wall time (other load can only lower it).
         assert!(busy.cpu_seconds <= busy.wall_seconds + 0.01, "{busy:?}");
     }
 }
