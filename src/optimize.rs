@@ -60,24 +60,31 @@ impl MapEstimate {
 }
 
 /// Settings of the MAP search.
+///
+/// Two searches share the code: the precise one ([`MapSettings::default`]) that every sampler
+/// starts from, whose MAP the pinned draws (tests/fingerprint_table1.rs) and the paper's
+/// tables depend on to the bit, and the one a diagnosis runs for each of its many candidate
+/// fits ([`MapSettings::ranking`]), which stops as soon as further steps cannot change a score.
 #[derive(Clone, Debug)]
 pub struct MapSettings {
     pub max_iterations: u64,
     /// Where L-BFGS hands over to the Gauss–Newton polish: the gradient's norm in the
     /// coordinates whitened by the metric at the start, about posterior standard deviations
-    /// from the mode. At 10⁻² the point is well inside the region where Newton steps on the
-    /// metric converge quadratically (two or three of them reach the rounding), while the last
-    /// decades of L-BFGS's linear convergence cost most of its solves: on the development set
-    /// (rank-only) 10⁻⁷ and a second re-whitened L-BFGS round took 9 977 line-search solves
-    /// on case 07 where 10⁻² and one round took 1 805, for the same selections.
+    /// from the mode.
     pub gradient_tolerance: f64,
+    /// Rounds of L-BFGS, each re-whitened at the previous one's answer.
+    pub rounds: usize,
+    /// L-BFGS's cost call solves with sensitivities and keeps the gradient for the gradient
+    /// call at the same point (More–Thuente asks for both at every trial point): one
+    /// dual-number solve per point instead of a plain solve and a dual-number one. Off in the
+    /// precise search, whose line search sees the plain solve's value: a plain and a
+    /// dual-number solve round differently, and the pinned draws start from that MAP.
+    pub cost_with_gradient: bool,
     /// Stop the Gauss–Newton polish once its predicted gain ½·decrement² is down at the log
     /// density's rounding (~10⁻¹² of it): a step whose gain the log density cannot resolve
     /// can be neither verified nor refused by the line search, which then halves it up to 30
-    /// times (a solve each) or accepts a step of nothing and goes round again. On by default:
-    /// counted on the development set, the full polish spent up to 1 400 solves per candidate
-    /// fit there at decrements of 10⁻⁸–10⁻⁶ posterior standard deviations. Off, the polish
-    /// runs to a decrement of 10⁻⁹ or 50 steps.
+    /// times (a solve each) or accepts a step of nothing and goes round again. Off, the
+    /// polish runs to a decrement of 10⁻⁹ or 50 steps.
     pub stop_at_rounding: bool,
 }
 
@@ -85,8 +92,29 @@ impl Default for MapSettings {
     fn default() -> Self {
         Self {
             max_iterations: 2000,
+            gradient_tolerance: 1e-7,
+            rounds: 2,
+            cost_with_gradient: false,
+            stop_at_rounding: false,
+        }
+    }
+}
+
+impl MapSettings {
+    /// The search for a diagnosis's candidate fits: one L-BFGS round to a whitened gradient of
+    /// 10⁻², well inside the region where Newton steps on the metric converge quadratically,
+    /// then the polish to the log density's rounding. Counted on development case 07
+    /// (rank-only), the precise search spent 9 977 line-search solves where this spends
+    /// 1 805, and its polish up to 1 400 solves in a fit at decrements of 10⁻⁸–10⁻⁶ posterior
+    /// standard deviations; the selections, the top three scores (to 0.01 nat) and the verdict
+    /// are the same on all fourteen development cases.
+    pub fn ranking() -> Self {
+        Self {
             gradient_tolerance: 1e-2,
+            rounds: 1,
+            cost_with_gradient: true,
             stop_at_rounding: true,
+            ..Self::default()
         }
     }
 }
@@ -99,10 +127,9 @@ struct Whitened<'a, P> {
     origin: Vec<f64>,
     /// L⁻ᵀ
     transform: DMatrix<f64>,
-    /// The gradient in z the last cost call computed, and where. More–Thuente asks for the
-    /// gradient at every point whose cost it asked for, so the cost solves with sensitivities
-    /// once and the gradient call is served from here: one dual-number solve per trial point
-    /// instead of a plain solve followed by a dual-number one.
+    /// Whether the cost call computes the gradient too ([`MapSettings::cost_with_gradient`]).
+    cost_with_gradient: bool,
+    /// The gradient in z the last cost call computed, and where.
     last: RefCell<Option<(Vec<f64>, Vec<f64>)>>,
 }
 
@@ -149,9 +176,18 @@ impl<P: FisherMetric> CostFunction for Whitened<'_, P> {
     type Param = Vec<f64>;
     type Output = f64;
     fn cost(&self, z: &Self::Param) -> Result<f64, argmin::core::Error> {
-        let (lp, gz) = self.evaluate(z)?;
-        *self.last.borrow_mut() = Some((z.clone(), gz));
-        Ok(if lp.is_finite() { -lp } else { OUTSIDE })
+        if self.cost_with_gradient {
+            let (lp, gz) = self.evaluate(z)?;
+            *self.last.borrow_mut() = Some((z.clone(), gz));
+            return Ok(if lp.is_finite() { -lp } else { OUTSIDE });
+        }
+        let x = self.to_x(z);
+        match self.density.borrow_mut().log_density(&x) {
+            Ok(lp) if lp.is_finite() => Ok(-lp),
+            Ok(_) => Ok(OUTSIDE),
+            Err(e) if e.recoverable => Ok(OUTSIDE),
+            Err(e) => Err(argmin_error(e)),
+        }
     }
 }
 
@@ -199,9 +235,8 @@ pub fn find_map<P: FisherMetric>(
     let d = density.dim();
     let mut x0 = start.to_vec();
     let mut iterations = 0;
-    // One round of L-BFGS into the Newton region; the polish re-evaluates the metric at every
-    // step, so a second L-BFGS round re-whitened at the first one's answer is not needed.
-    {
+    // Each round re-whitens at the previous one's answer, where the metric is closer to right.
+    for _ in 0..settings.rounds {
         let mut metric = DMatrix::zeros(d, d);
         density.fisher_metric(&x0, &mut metric)?;
         let chol = cholesky_factor(&metric)?;
@@ -216,6 +251,7 @@ pub fn find_map<P: FisherMetric>(
             density: RefCell::new(&mut *density),
             origin: x0.clone(),
             transform: l_inv_t,
+            cost_with_gradient: settings.cost_with_gradient,
             last: RefCell::new(None),
         };
         let linesearch = MoreThuenteLineSearch::new();

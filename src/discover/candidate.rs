@@ -293,7 +293,7 @@ fn best_map(
     let mut best: Option<MapEstimate> = None;
     let mut last_error = None;
     for s in starts {
-        match find_map(posterior, &s, &MapSettings::default()) {
+        match find_map(posterior, &s, &MapSettings::ranking()) {
             Ok(map) => {
                 if best
                     .as_ref()

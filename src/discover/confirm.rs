@@ -17,6 +17,6 @@ pub const DRAWS: usize = 2000;
 /// from where the ranking left it.
 pub fn importance_evidence(fit: &Candidate, seed: u64) -> Result<Confirmation, Error> {
     let mut posterior = fit.posterior.clone();
-    let map = find_map(&mut posterior, &fit.map.x, &MapSettings::default())?;
+    let map = find_map(&mut posterior, &fit.map.x, &MapSettings::ranking())?;
     importance_sampling(&mut posterior, &map, DRAWS, seed).map_err(Error::Numerical)
 }

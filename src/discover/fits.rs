@@ -122,7 +122,7 @@ fn laplace_run(posterior: &mut CalibrationPosterior, seed: u64) -> Result<RunOut
     use rand_distr::{Distribution, StandardNormal};
     let started = std::time::Instant::now();
     let start = posterior.initial_point()?;
-    let map = find_map(posterior, &start, &MapSettings::default())?;
+    let map = find_map(posterior, &start, &MapSettings::ranking())?;
     let (l_inv_t, _) = map.whitening().map_err(Error::Numerical)?;
     let mut rng = chain_rng(seed ^ 0x1a91_ace0, 0);
     let d = map.x.len();
