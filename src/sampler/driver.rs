@@ -1,6 +1,7 @@
 //! The driver: warm-up then sampling for any kernel and adaptation, one chain or several in
 //! parallel, with per-chain random streams so that draws do not depend on the thread count.
 
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use indicatif::ProgressBar;
@@ -102,8 +103,8 @@ impl ChainOutput {
 #[allow(clippy::too_many_arguments)]
 pub fn run_chain<P, K, A>(
     density: P,
-    mut kernel: K,
-    mut adaptation: A,
+    kernel: K,
+    adaptation: A,
     init: &[f64],
     settings: &ChainSettings,
     rng: &mut ChaCha8Rng,
@@ -115,6 +116,42 @@ where
     K: Kernel<Counted<P>>,
     A: Adaptation<K>,
 {
+    let chain_run = (init, settings, chain, progress, None);
+    run_chain_until(density, kernel, adaptation, rng, chain_run)
+}
+
+/// The message of a run stopped by its stop flag.
+pub const STOPPED: &str = "stopped on request";
+
+/// One chain's place in a run: its initial point, settings, index, progress bar and the run's
+/// stop flag.
+type ChainRun<'a> = (
+    &'a [f64],
+    &'a ChainSettings,
+    usize,
+    Option<&'a ProgressBar>,
+    Option<&'a AtomicBool>,
+);
+
+/// [`run_chain`], returning the fatal error [`STOPPED`] before the first transition after
+/// `stop` is set (checked between transitions; a set flag never changes a draw, only ends the
+/// run).
+fn run_chain_until<P, K, A>(
+    density: P,
+    mut kernel: K,
+    mut adaptation: A,
+    rng: &mut ChaCha8Rng,
+    (init, settings, chain, progress, stop): ChainRun<'_>,
+) -> Result<(ChainOutput, K), DensityError>
+where
+    P: LogDensity,
+    K: Kernel<Counted<P>>,
+    A: Adaptation<K>,
+{
+    let check = || match stop {
+        Some(flag) if flag.load(Ordering::Relaxed) => Err(DensityError::fatal(STOPPED)),
+        _ => Ok(()),
+    };
     settings.validate().map_err(DensityError::fatal)?;
     // The warm-up's time includes the initial point's evaluation, as its counts do.
     let warmup_watch = Stopwatch::start();
@@ -131,6 +168,7 @@ where
 
     let mut divergences_warmup = 0usize;
     for iteration in 0..settings.warmup {
+        check()?;
         let info = kernel.step(&mut density, &mut state, rng)?;
         divergences_warmup += info.divergent as usize;
         adaptation.observe(&mut kernel, &state, &info, iteration, settings.warmup);
@@ -149,6 +187,7 @@ where
     let mut last_step_size = f64::NAN;
     let sampling_watch = Stopwatch::start();
     for i in 0..settings.draws {
+        check()?;
         let info = kernel.step(&mut density, &mut state, rng)?;
         divergences += info.divergent as usize;
         accept_sum += info.accept_stat;
@@ -212,6 +251,25 @@ where
     A: Adaptation<K>,
     F: Fn(usize) -> Result<(P, K, A), DensityError> + Sync,
 {
+    run_chains_until(inits, settings, seed, make, progress, None)
+}
+
+/// [`run_chains`] that ends with the fatal error [`STOPPED`] soon after `stop` is set: every
+/// chain checks it between transitions.
+pub fn run_chains_until<P, K, A, F>(
+    inits: &[Vec<f64>],
+    settings: &ChainSettings,
+    seed: u64,
+    make: F,
+    progress: Option<&[ProgressBar]>,
+    stop: Option<&AtomicBool>,
+) -> Result<Vec<(ChainOutput, K)>, DensityError>
+where
+    P: LogDensity,
+    K: Kernel<Counted<P>> + Send,
+    A: Adaptation<K>,
+    F: Fn(usize) -> Result<(P, K, A), DensityError> + Sync,
+{
     inits
         .par_iter()
         .enumerate()
@@ -219,9 +277,8 @@ where
             let (density, kernel, adaptation) = make(chain)?;
             let mut rng = chain_rng(seed, chain);
             let bar = progress.and_then(|bars| bars.get(chain));
-            run_chain(
-                density, kernel, adaptation, init, settings, &mut rng, chain, bar,
-            )
+            let chain_run = (init.as_slice(), settings, chain, bar, stop);
+            run_chain_until(density, kernel, adaptation, &mut rng, chain_run)
         })
         .collect()
 }
