@@ -180,11 +180,10 @@ def _inference_data(arviz, posterior, unconstrained, stats, raw, figures):
         posterior=posterior,
         sample_stats={CMDSTAN_TO_ARVIZ[k]: v for k, v in stats.items()},
         observed_data=raw["observed_data"],
-        attrs=attrs,
     )
-    idata.add_groups(
-        {"unconstrained_posterior": arviz.dict_to_dataset(unconstrained, attrs=attrs)}
-    )
+    idata.add_groups({"unconstrained_posterior": arviz.dict_to_dataset(unconstrained)})
+    for group in ("posterior", "sample_stats", "unconstrained_posterior"):
+        idata[group].attrs.update(attrs)
     for key, value in figures.items():
         object.__setattr__(idata, key, value)
     return idata
