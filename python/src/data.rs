@@ -82,17 +82,20 @@ fn from_columns(
     let n = time.len();
     for (name, values) in columns {
         if values.len() != n {
-            return Err(err(
-                name,
-                format!("{} values, but t has {n}", values.len()),
-            ));
+            return Err(err(name, format!("{} values, but t has {n}", values.len())));
         }
         if let Some((i, v)) = values.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-            return Err(err(name, format!("value {v} at index {i} is not a finite number")));
+            return Err(err(
+                name,
+                format!("value {v} at index {i} is not a finite number"),
+            ));
         }
     }
     if n < 2 {
-        return Err(err("t", format!("only {n} samples; a recording needs at least 2")));
+        return Err(err(
+            "t",
+            format!("only {n} samples; a recording needs at least 2"),
+        ));
     }
     if time[0] < 0.0 {
         return Err(err("t", format!("time {} is negative", time[0])));
@@ -181,8 +184,8 @@ impl Recording {
     #[pyo3(signature = (path, model=None))]
     fn from_csv(path: PathBuf, model: Option<&Model>) -> PyResult<Self> {
         let file = model_file(model);
-        let read = read_recording_for(&path, &file.channels, file.base)
-            .map_err(|e| py_error(e.into()))?;
+        let read =
+            read_recording_for(&path, &file.channels, file.base).map_err(|e| py_error(e.into()))?;
         Ok(Self {
             source: Source::File(path),
             read,
@@ -279,7 +282,11 @@ impl Recording {
             self.source(),
             self.read.n_samples(),
             names.join(", "),
-            if self.read.voltage.is_some() { ", U" } else { "" }
+            if self.read.voltage.is_some() {
+                ", U"
+            } else {
+                ""
+            }
         )
     }
 }
@@ -317,8 +324,8 @@ impl Model {
         let text = toml::to_string(&toml_value)
             .map_err(|e| bad(format!("not a model file's tables: {e}")))?;
         // The line is the generated TOML's: the field names the place.
-        let file = parse_model_file(&text, source)
-            .map_err(|e| py_error(e.at_line_opt(None).into()))?;
+        let file =
+            parse_model_file(&text, source).map_err(|e| py_error(e.at_line_opt(None).into()))?;
         Ok(Self {
             file,
             source: "dict".into(),
@@ -355,10 +362,15 @@ impl Model {
     }
 
     fn __repr__(&self) -> String {
-        format!("Model({}: {} base, terms [{}])", self.source, self.base(), {
-            let names: Vec<&str> = self.file.terms.iter().map(|t| t.term.name()).collect();
-            names.join(", ")
-        })
+        format!(
+            "Model({}: {} base, terms [{}])",
+            self.source,
+            self.base(),
+            {
+                let names: Vec<&str> = self.file.terms.iter().map(|t| t.term.name()).collect();
+                names.join(", ")
+            }
+        )
     }
 }
 

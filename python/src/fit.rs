@@ -8,10 +8,10 @@ use motorcal::density::LogDensity;
 use motorcal::error::Error;
 use motorcal::optimize::MapEstimate;
 use motorcal::pipeline::{
-    MetricAdaptation, RunCost, RunOutput, RunSettings, SamplerKind, default_warmup,
-    map_estimate, posterior_mean, run_sampler, write_draws,
+    MetricAdaptation, RunCost, RunOutput, RunSettings, SamplerKind, default_warmup, map_estimate,
+    posterior_mean, run_sampler, write_draws,
 };
-use motorcal::sampler::ChainSettings;
+use motorcal::sampler::{ChainSettings, DrawRecord};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -106,15 +106,13 @@ fn fit_work(
     })
 }
 
-/// Values of every kept draw of every chain, chain-major: `(chains, draws, columns)`.
+/// Values of `draws` draws of every chain, chain-major: `(chains, draws, columns)`.
 fn cube<'py>(
     py: Python<'py>,
-    run: &RunOutput,
+    (chains, draws): (usize, usize),
     columns: usize,
     value: impl Fn(usize, usize) -> Vec<f64>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let chains = run.chains.len();
-    let draws = run.chains.first().map_or(0, |c| c.draws.len());
     let mut flat = Vec::with_capacity(chains * draws * columns);
     for c in 0..chains {
         for s in 0..draws {
@@ -129,7 +127,7 @@ fn cube<'py>(
 /// Runs the fit; returns a dict of NumPy arrays and the fit's figures (see
 /// `motorcal.fit`).
 #[pyfunction]
-#[pyo3(signature = (recordings, model, bm=None, k=None, sampler="nuts-dense", chains=4, warmup=None, draws=1000, keep=None, seed=motorcal::synthetic::DEFAULT_SEED, threads=None, metric_adaptation=None, prior_family="laplace", prior_decay=0.0, force=false, out=None))]
+#[pyo3(signature = (recordings, model, bm=None, k=None, sampler="nuts-dense", chains=4, warmup=None, draws=1000, keep=None, seed=motorcal::synthetic::DEFAULT_SEED, threads=None, metric_adaptation=None, prior_family="laplace", prior_decay=0.0, force=false, out=None, save_warmup=true))]
 #[allow(clippy::too_many_arguments)]
 pub fn fit_raw<'py>(
     py: Python<'py>,
@@ -149,6 +147,7 @@ pub fn fit_raw<'py>(
     prior_decay: f64,
     force: bool,
     out: Option<PathBuf>,
+    save_warmup: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let calibration = Calibration {
         bm,
@@ -168,6 +167,7 @@ pub fn fit_raw<'py>(
         metric_adaptation,
     )
     .map_err(py_error)?;
+    settings.save_warmup = save_warmup;
     let fitted = interruptible(py, |stop| {
         settings.stop = Some(stop);
         fit_work(&recordings, &model, &calibration, &settings, out.as_ref())
@@ -182,38 +182,48 @@ fn report<'py>(py: Python<'py>, f: &Fitted) -> PyResult<Bound<'py, PyDict>> {
     let dict = PyDict::new(py);
     let names = posterior.output_names();
     let coordinates = posterior.parameter_names();
+    let chains = run.chains.len();
+    let kept = (chains, run.chains.first().map_or(0, |c| c.draws.len()));
+    let warmup = (
+        chains,
+        run.chains.first().map_or(0, |c| c.warmup_draws.len()),
+    );
     dict.set_item("names", &names)?;
     dict.set_item(
         "draws",
-        cube(py, run, names.len(), |c, s| run.chains[c].draws[s].clone())?,
+        cube(py, kept, names.len(), |c, s| run.chains[c].draws[s].clone())?,
     )?;
     dict.set_item("unconstrained_names", &coordinates)?;
     dict.set_item(
         "unconstrained",
-        cube(py, run, coordinates.len(), |c, s| {
+        cube(py, kept, coordinates.len(), |c, s| {
             run.chains[c].unconstrained[s].clone()
         })?,
     )?;
-    let stats = PyDict::new(py);
-    type Stat = fn(&motorcal::sampler::DrawRecord) -> f64;
-    let columns: [(&str, Stat); 7] = [
-        ("lp__", |r| r.lp),
-        ("accept_stat__", |r| r.accept_stat),
-        ("stepsize__", |r| r.step_size),
-        ("treedepth__", |r| r.tree_depth as f64),
-        ("n_leapfrog__", |r| r.n_steps as f64),
-        ("divergent__", |r| r.divergent as u8 as f64),
-        ("energy__", |r| r.energy),
-    ];
-    for (name, value) in columns {
-        let array = cube(py, run, 1, |c, s| vec![value(&run.chains[c].records[s])])?;
-        stats.set_item(name, array.call_method1("squeeze", (2,))?)?;
+    dict.set_item(
+        "sample_stats",
+        stats(py, kept, |c, s| &run.chains[c].records[s])?,
+    )?;
+    if warmup.1 > 0 {
+        dict.set_item(
+            "warmup_draws",
+            cube(py, warmup, names.len(), |c, s| {
+                run.chains[c].warmup_draws[s].clone()
+            })?,
+        )?;
+        dict.set_item(
+            "warmup_sample_stats",
+            stats(py, warmup, |c, s| &run.chains[c].warmup_records[s])?,
+        )?;
     }
-    dict.set_item("sample_stats", stats)?;
     let observed = PyDict::new(py);
     let several = posterior.n_records() > 1;
     for r in 0..posterior.n_records() {
-        let suffix = if several { format!("_r{}", r + 1) } else { String::new() };
+        let suffix = if several {
+            format!("_r{}", r + 1)
+        } else {
+            String::new()
+        };
         for (c, name) in posterior.channel_names(r).into_iter().enumerate() {
             let values = posterior.observed(r, c);
             observed.set_item(format!("{name}{suffix}"), PyArray1::from_slice(py, values))?;
@@ -240,4 +250,28 @@ fn report<'py>(py: Python<'py>, f: &Fitted) -> PyResult<Bound<'py, PyDict>> {
     dict.set_item("wall_seconds", run.wall_seconds)?;
     dict.set_item("outputs", &f.outputs)?;
     Ok(dict)
+}
+
+/// CmdStan's seven sampler columns of `shape` draws, `(chains, draws)` arrays by column name.
+fn stats<'py, 'a>(
+    py: Python<'py>,
+    shape: (usize, usize),
+    record: impl Fn(usize, usize) -> &'a DrawRecord,
+) -> PyResult<Bound<'py, PyDict>> {
+    type Stat = fn(&DrawRecord) -> f64;
+    let columns: [(&str, Stat); 7] = [
+        ("lp__", |r| r.lp),
+        ("accept_stat__", |r| r.accept_stat),
+        ("stepsize__", |r| r.step_size),
+        ("treedepth__", |r| r.tree_depth as f64),
+        ("n_leapfrog__", |r| r.n_steps as f64),
+        ("divergent__", |r| r.divergent as u8 as f64),
+        ("energy__", |r| r.energy),
+    ];
+    let stats = PyDict::new(py);
+    for (name, value) in columns {
+        let array = cube(py, shape, 1, |c, s| vec![value(record(c, s))])?;
+        stats.set_item(name, array.call_method1("squeeze", (2,))?)?;
+    }
+    Ok(stats)
 }

@@ -62,6 +62,11 @@ fn _motorcal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(reports::bench, m)?)?;
     m.add_function(wrap_pyfunction!(reports::sweep, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
-    m.add("SAMPLERS", motorcal::pipeline::SamplerKind::ALL.map(|s| s.name()).to_vec())?;
+    m.add(
+        "SAMPLERS",
+        motorcal::pipeline::SamplerKind::ALL
+            .map(|s| s.name())
+            .to_vec(),
+    )?;
     Ok(())
 }

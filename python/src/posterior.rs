@@ -155,9 +155,13 @@ fn theta_vec(theta: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
     let array = py
         .import("numpy")?
         .call_method("ascontiguousarray", (theta,), Some(&kwargs))?;
-    let array = array
-        .cast::<PyArray1<f64>>()
-        .map_err(|_| py_error(Error::setting("theta", "", "must be a 1-D array of numbers")))?;
+    let array = array.cast::<PyArray1<f64>>().map_err(|_| {
+        py_error(Error::setting(
+            "theta",
+            "",
+            "must be a 1-D array of numbers",
+        ))
+    })?;
     Ok(array.readonly().as_slice()?.to_vec())
 }
 
@@ -268,16 +272,17 @@ impl Posterior {
         out.set_item("laplace_sd", PyArray1::from_vec(py, map.laplace_sd()))?;
         let d = map.x.len();
         let hessian: Vec<f64> = map.hessian.transpose().iter().copied().collect();
-        out.set_item(
-            "hessian",
-            PyArray1::from_vec(py, hessian).reshape([d, d])?,
-        )?;
+        out.set_item("hessian", PyArray1::from_vec(py, hessian).reshape([d, d])?)?;
         out.set_item("log_evidence_laplace", map.log_evidence_laplace)?;
         Ok(out)
     }
 
     fn __repr__(&self) -> String {
-        format!("Posterior({}, {} coordinates)", self.settings.label(), self.inner.dim())
+        format!(
+            "Posterior({}, {} coordinates)",
+            self.settings.label(),
+            self.inner.dim()
+        )
     }
 }
 
@@ -297,7 +302,16 @@ pub fn log_density(
     prior_decay: f64,
     force: bool,
 ) -> PyResult<f64> {
-    let mut p = Posterior::new(py, recordings, model, bm, k, prior_family, prior_decay, force)?;
+    let mut p = Posterior::new(
+        py,
+        recordings,
+        model,
+        bm,
+        k,
+        prior_family,
+        prior_decay,
+        force,
+    )?;
     p.log_density(py, theta)
 }
 
@@ -316,6 +330,15 @@ pub fn log_density_gradient<'py>(
     prior_decay: f64,
     force: bool,
 ) -> PyResult<(f64, Bound<'py, PyArray1<f64>>)> {
-    let mut p = Posterior::new(py, recordings, model, bm, k, prior_family, prior_decay, force)?;
+    let mut p = Posterior::new(
+        py,
+        recordings,
+        model,
+        bm,
+        k,
+        prior_family,
+        prior_decay,
+        force,
+    )?;
     p.log_density_gradient(py, theta)
 }

@@ -40,13 +40,21 @@ pub fn simulate(
         .find(|p| p.name() == input)
         .ok_or_else(|| {
             let names: Vec<&str> = InputProfile::ALL.iter().map(|p| p.name()).collect();
-            setting_error("input", input, &format!("expected one of {}", names.join(", ")))
+            setting_error(
+                "input",
+                input,
+                &format!("expected one of {}", names.join(", ")),
+            )
         })?;
     if samples < 2 {
         return Err(setting_error("samples", samples, "need at least 2 samples"));
     }
     if !(t_end > 0.0 && t_end.is_finite()) {
-        return Err(setting_error("t_end", t_end, "must be a positive number of seconds"));
+        return Err(setting_error(
+            "t_end",
+            t_end,
+            "must be a positive number of seconds",
+        ));
     }
     let noise = [noise_sd.0, noise_sd.1];
     if noise.iter().any(|s| !(*s >= 0.0 && s.is_finite())) {
@@ -62,8 +70,7 @@ pub fn simulate(
     let motor = file
         .model(voltage.clone())
         .map_err(|e| py_error(Error::invalid(format!("model: {e}"))))?;
-    let data = generate(&motor, &times, &noise, seed)
-        .map_err(|e| py_error(Error::numerical(e)))?;
+    let data = generate(&motor, &times, &noise, seed).map_err(|e| py_error(Error::numerical(e)))?;
     let held = match voltage {
         motorcal::motor::VoltageInput::Held { values, .. } => Some(values),
         motorcal::motor::VoltageInput::Constant => None,

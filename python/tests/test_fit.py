@@ -105,3 +105,14 @@ def test_an_interrupted_fit_raises_and_writes_nothing(recording, model, tmp_path
     finally:
         timer.cancel()
     assert not out.exists() or not any(out.iterdir())
+
+
+def test_the_warmup_groups_hold_every_warmup_draw(py_fit):
+    warmup = py_fit.warmup_posterior
+    # 100: the Laplace metric's default warm-up for NUTS.
+    assert warmup["R"].shape == (OPTIONS["chains"], 100)
+    assert set(py_fit.warmup_sample_stats.data_vars) == set(motorcal.CMDSTAN_TO_ARVIZ.values())
+    step = py_fit.warmup_sample_stats.step_size.values
+    # Dual averaging moves the step size in warm-up; sampling keeps the one it settled on.
+    assert len(np.unique(step[0])) > 1
+    assert len(np.unique(py_fit.sample_stats.step_size.values[0])) == 1

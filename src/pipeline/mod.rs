@@ -29,7 +29,7 @@ use crate::sampler::mala::{Mala, MalaAdaptation};
 use crate::sampler::metric::{Metric, MetricKind};
 use crate::sampler::metropolis::{Metropolis, PyMc3Tuning};
 use crate::sampler::nuts::{Nuts, NutsSettings};
-use crate::sampler::{Adaptation, ChainOutput, Kernel, run_chains_until};
+use crate::sampler::{Adaptation, ChainOutput, Kernel, RunControl, run_chains_until};
 
 use crate::error::{Error, InputError};
 
@@ -162,7 +162,10 @@ where
                 Ok((posterior.clone(), k, a))
             },
             bars.as_ref().map(|(_, b)| b.as_slice()),
-            settings.stop.as_deref(),
+            RunControl {
+                stop: settings.stop.as_deref(),
+                save_warmup: settings.save_warmup,
+            },
         )
     };
     let result = match settings.threads {

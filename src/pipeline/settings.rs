@@ -171,6 +171,9 @@ pub struct RunSettings {
     /// fatal error [`crate::sampler::STOPPED`]; `None` runs to the end.
     #[serde(skip)]
     pub stop: Option<Arc<AtomicBool>>,
+    /// Keep every warm-up draw in the chains' output too (the draws are the same either way).
+    #[serde(skip)]
+    pub save_warmup: bool,
 }
 
 impl Default for RunSettings {
@@ -187,6 +190,7 @@ impl Default for RunSettings {
             load_adaptation: None,
             metric_adaptation: MetricAdaptation::default(),
             stop: None,
+            save_warmup: false,
         }
     }
 }

@@ -67,6 +67,21 @@ pub struct DrawRecord {
     pub energy: f64,
 }
 
+impl DrawRecord {
+    /// The columns of the transition that left the chain at `state`.
+    fn of(state: &State, info: &Info) -> Self {
+        Self {
+            lp: state.log_density,
+            accept_stat: info.accept_stat,
+            step_size: info.step_size,
+            tree_depth: info.tree_depth,
+            n_steps: info.n_steps,
+            divergent: info.divergent,
+            energy: info.energy,
+        }
+    }
+}
+
 /// Everything a chain produced.
 #[derive(Clone, Debug, Serialize)]
 pub struct ChainOutput {
@@ -89,6 +104,12 @@ pub struct ChainOutput {
     pub mean_accept_stat: f64,
     /// The step size (or proposal scale) the kernel ended with.
     pub final_step_size: f64,
+    /// Every warm-up draw (constrained) and its sampler columns, when the run's
+    /// [`RunControl::save_warmup`] asked for them; empty otherwise.
+    #[serde(skip)]
+    pub warmup_draws: Vec<Vec<f64>>,
+    #[serde(skip)]
+    pub warmup_records: Vec<DrawRecord>,
 }
 
 impl ChainOutput {
@@ -116,39 +137,59 @@ where
     K: Kernel<Counted<P>>,
     A: Adaptation<K>,
 {
-    let chain_run = (init, settings, chain, progress, None);
+    let chain_run = ChainRun {
+        init,
+        settings,
+        chain,
+        progress,
+        control: RunControl::default(),
+    };
     run_chain_until(density, kernel, adaptation, rng, chain_run)
 }
 
 /// The message of a run stopped by its stop flag.
 pub const STOPPED: &str = "stopped on request";
 
-/// One chain's place in a run: its initial point, settings, index, progress bar and the run's
-/// stop flag.
-type ChainRun<'a> = (
-    &'a [f64],
-    &'a ChainSettings,
-    usize,
-    Option<&'a ProgressBar>,
-    Option<&'a AtomicBool>,
-);
+/// What a caller asks of a run beside its settings: a flag that stops it, and whether the
+/// warm-up's draws are kept too. Neither changes a draw.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RunControl<'a> {
+    /// Checked between transitions: once set, the run ends with the fatal error [`STOPPED`].
+    pub stop: Option<&'a AtomicBool>,
+    /// Keep every warm-up draw in [`ChainOutput::warmup_draws`] and `warmup_records`.
+    pub save_warmup: bool,
+}
 
-/// [`run_chain`], returning the fatal error [`STOPPED`] before the first transition after
-/// `stop` is set (checked between transitions; a set flag never changes a draw, only ends the
-/// run).
+/// One chain's place in a run.
+struct ChainRun<'a> {
+    init: &'a [f64],
+    settings: &'a ChainSettings,
+    chain: usize,
+    progress: Option<&'a ProgressBar>,
+    control: RunControl<'a>,
+}
+
+/// [`run_chain`] under a [`RunControl`].
 fn run_chain_until<P, K, A>(
     density: P,
     mut kernel: K,
     mut adaptation: A,
     rng: &mut ChaCha8Rng,
-    (init, settings, chain, progress, stop): ChainRun<'_>,
+    run: ChainRun<'_>,
 ) -> Result<(ChainOutput, K), DensityError>
 where
     P: LogDensity,
     K: Kernel<Counted<P>>,
     A: Adaptation<K>,
 {
-    let check = || match stop {
+    let ChainRun {
+        init,
+        settings,
+        chain,
+        progress,
+        control,
+    } = run;
+    let check = || match control.stop {
         Some(flag) if flag.load(Ordering::Relaxed) => Err(DensityError::fatal(STOPPED)),
         _ => Ok(()),
     };
@@ -167,10 +208,17 @@ where
     let reporter = Reporter::new(progress, total);
 
     let mut divergences_warmup = 0usize;
+    let mut constrained = Vec::new();
+    let (mut warmup_draws, mut warmup_records) = (Vec::new(), Vec::new());
     for iteration in 0..settings.warmup {
         check()?;
         let info = kernel.step(&mut density, &mut state, rng)?;
         divergences_warmup += info.divergent as usize;
+        if control.save_warmup {
+            density.constrain(&state.x, &mut constrained);
+            warmup_draws.push(constrained.clone());
+            warmup_records.push(DrawRecord::of(&state, &info));
+        }
         adaptation.observe(&mut kernel, &state, &info, iteration, settings.warmup);
         reporter.tick(iteration, &info, divergences_warmup, "warm-up");
     }
@@ -183,7 +231,6 @@ where
     let mut records = Vec::with_capacity(settings.kept());
     let mut divergences = 0usize;
     let mut accept_sum = 0.0;
-    let mut constrained = Vec::new();
     let mut last_step_size = f64::NAN;
     let sampling_watch = Stopwatch::start();
     for i in 0..settings.draws {
@@ -196,15 +243,7 @@ where
             density.constrain(&state.x, &mut constrained);
             draws.push(constrained.clone());
             unconstrained.push(state.x.clone());
-            records.push(DrawRecord {
-                lp: state.log_density,
-                accept_stat: info.accept_stat,
-                step_size: info.step_size,
-                tree_depth: info.tree_depth,
-                n_steps: info.n_steps,
-                divergent: info.divergent,
-                energy: info.energy,
-            });
+            records.push(DrawRecord::of(&state, &info));
         }
         reporter.tick(settings.warmup + i, &info, divergences, "sampling");
     }
@@ -223,6 +262,8 @@ where
         divergences,
         mean_accept_stat: accept_sum / settings.draws as f64,
         final_step_size: last_step_size,
+        warmup_draws,
+        warmup_records,
     };
     Ok((output, kernel))
 }
@@ -251,18 +292,18 @@ where
     A: Adaptation<K>,
     F: Fn(usize) -> Result<(P, K, A), DensityError> + Sync,
 {
-    run_chains_until(inits, settings, seed, make, progress, None)
+    run_chains_until(inits, settings, seed, make, progress, RunControl::default())
 }
 
-/// [`run_chains`] that ends with the fatal error [`STOPPED`] soon after `stop` is set: every
-/// chain checks it between transitions.
+/// [`run_chains`] under a [`RunControl`]: stopped soon after its flag is set (every chain
+/// checks it between transitions), keeping the warm-up's draws if asked.
 pub fn run_chains_until<P, K, A, F>(
     inits: &[Vec<f64>],
     settings: &ChainSettings,
     seed: u64,
     make: F,
     progress: Option<&[ProgressBar]>,
-    stop: Option<&AtomicBool>,
+    control: RunControl<'_>,
 ) -> Result<Vec<(ChainOutput, K)>, DensityError>
 where
     P: LogDensity,
@@ -277,7 +318,13 @@ where
             let (density, kernel, adaptation) = make(chain)?;
             let mut rng = chain_rng(seed, chain);
             let bar = progress.and_then(|bars| bars.get(chain));
-            let chain_run = (init.as_slice(), settings, chain, bar, stop);
+            let chain_run = ChainRun {
+                init,
+                settings,
+                chain,
+                progress: bar,
+                control,
+            };
             run_chain_until(density, kernel, adaptation, &mut rng, chain_run)
         })
         .collect()

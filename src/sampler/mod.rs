@@ -23,7 +23,8 @@ pub mod welford;
 
 pub use cost::PhaseCost;
 pub use driver::{
-    ChainOutput, ChainSettings, DrawRecord, STOPPED, run_chain, run_chains, run_chains_until,
+    ChainOutput, ChainSettings, DrawRecord, RunControl, STOPPED, run_chain, run_chains,
+    run_chains_until,
 };
 
 use rand_chacha::ChaCha8Rng;

@@ -104,6 +104,7 @@ def fit(
     prior_decay=0.0,
     force=False,
     out=None,
+    save_warmup=True,
     inference_data=None,
 ):
     """Calibrate ``model`` on ``recordings`` (one or a list) as ``motorcal fit`` does: the MAP
@@ -115,7 +116,8 @@ def fit(
     an interrupted fit writes nothing.
 
     Returns ``arviz.InferenceData`` (posterior, sample_stats, observed_data and the
-    ``unconstrained`` group of the sampler's coordinates) when ArviZ imports and
+    ``unconstrained_posterior`` group of the sampler's coordinates, and with ``save_warmup``
+    the warm-up's draws as ``warmup_posterior`` and ``warmup_sample_stats``) when ArviZ imports and
     ``inference_data`` is not False, else a :class:`FitResult` of NumPy arrays. Either way
     ``result.map`` ({coordinate: (value, laplace_sd)}), ``result.log_evidence_laplace``,
     ``result.cost`` (the whole cost: wall and CPU time per phase, evaluations, ESS per unit),
@@ -138,16 +140,20 @@ def fit(
         prior_decay=prior_decay,
         force=force,
         out=None if out is None else str(out),
+        save_warmup=save_warmup,
     )
     names = raw["names"]
     posterior = {name: raw["draws"][:, :, j] for j, name in enumerate(names)}
     unconstrained = {
         name: raw["unconstrained"][:, :, j] for j, name in enumerate(raw["unconstrained_names"])
     }
-    stats = dict(raw["sample_stats"])
-    stats["treedepth__"] = stats["treedepth__"].astype("int64")
-    stats["n_leapfrog__"] = stats["n_leapfrog__"].astype("int64")
-    stats["divergent__"] = stats["divergent__"].astype(bool)
+    stats = _typed(raw["sample_stats"])
+    warmup = None
+    if "warmup_draws" in raw:
+        warmup = {
+            "posterior": {name: raw["warmup_draws"][:, :, j] for j, name in enumerate(names)},
+            "sample_stats": _typed(raw["warmup_sample_stats"]),
+        }
     figures = {key: raw[key] for key in _FIGURES}
     if inference_data is not False:
         try:
@@ -156,18 +162,34 @@ def fit(
             if inference_data:
                 raise
         else:
-            return _inference_data(arviz, posterior, unconstrained, stats, raw, figures)
+            return _inference_data(arviz, posterior, unconstrained, stats, warmup, raw, figures)
     result = FitResult(
         posterior=posterior,
         sample_stats=stats,
         observed_data=raw["observed_data"],
         unconstrained=unconstrained,
     )
+    if warmup is not None:
+        result["warmup_posterior"] = warmup["posterior"]
+        result["warmup_sample_stats"] = warmup["sample_stats"]
     result.update(figures)
     return result
 
 
-def _inference_data(arviz, posterior, unconstrained, stats, raw, figures):
+def _typed(stats):
+    """CmdStan's columns with their types: integer tree depth and steps, boolean divergence."""
+    stats = dict(stats)
+    stats["treedepth__"] = stats["treedepth__"].astype("int64")
+    stats["n_leapfrog__"] = stats["n_leapfrog__"].astype("int64")
+    stats["divergent__"] = stats["divergent__"].astype(bool)
+    return stats
+
+
+def _arviz_names(stats):
+    return {CMDSTAN_TO_ARVIZ[k]: v for k, v in stats.items()}
+
+
+def _inference_data(arviz, posterior, unconstrained, stats, warmup, raw, figures):
     attrs = {
         "inference_library": "motorcal",
         "inference_library_version": __version__,
@@ -176,10 +198,18 @@ def _inference_data(arviz, posterior, unconstrained, stats, raw, figures):
         "log_evidence_laplace": raw["log_evidence_laplace"],
         "map_log_density": raw["map_log_density"],
     }
+    extra = {}
+    if warmup is not None:
+        extra = {
+            "warmup_posterior": warmup["posterior"],
+            "warmup_sample_stats": _arviz_names(warmup["sample_stats"]),
+            "save_warmup": True,
+        }
     idata = arviz.from_dict(
         posterior=posterior,
-        sample_stats={CMDSTAN_TO_ARVIZ[k]: v for k, v in stats.items()},
+        sample_stats=_arviz_names(stats),
         observed_data=raw["observed_data"],
+        **extra,
     )
     idata.add_groups({"unconstrained_posterior": arviz.dict_to_dataset(unconstrained)})
     for group in ("posterior", "sample_stats", "unconstrained_posterior"):
