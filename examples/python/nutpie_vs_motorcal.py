@@ -60,7 +60,7 @@ def nutpie_run(recording, model, k, chains, draws, tune, seed):
         probe.dim,
         make_logp_fn,
         make_expand_fn,
-        [np.float64] * len(names),
+        [np.dtype("float64")] * len(names),
         [()] * len(names),
         names,
         make_initial_point_fn=initial_point,

@@ -62,6 +62,7 @@ fn _motorcal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(reports::bench, m)?)?;
     m.add_function(wrap_pyfunction!(reports::sweep, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add("DEFAULT_SEED", motorcal::synthetic::DEFAULT_SEED)?;
     m.add(
         "SAMPLERS",
         motorcal::pipeline::SamplerKind::ALL

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from . import _motorcal
 from ._motorcal import (
+    DEFAULT_SEED,
     SAMPLERS,
     Model,
     Posterior,
@@ -31,6 +32,7 @@ from ._motorcal import (
 )
 
 __all__ = [
+    "DEFAULT_SEED",
     "SAMPLERS",
     "Model",
     "Posterior",
@@ -97,7 +99,7 @@ def fit(
     warmup=None,
     draws=1000,
     keep=None,
-    seed=20180823,
+    seed=DEFAULT_SEED,
     threads=None,
     metric_adaptation=None,
     prior_family="laplace",
