@@ -14,8 +14,10 @@ use pyo3::types::PyDict;
 use crate::data::{Model, Recording};
 use crate::py_error;
 
-/// One recording or a list of them.
+/// One recording or a list of them (extracted once per call: the size of one variant does not
+/// matter).
 #[derive(FromPyObject)]
+#[allow(clippy::large_enum_variant)]
 pub enum Recordings {
     One(Recording),
     Many(Vec<Recording>),
@@ -127,7 +129,7 @@ impl Posterior {
             return Err(py_error(Error::setting(
                 "theta",
                 format!("of length {}", theta.len()),
-                &format!(
+                format!(
                     "the posterior has {} coordinates ({})",
                     self.inner.dim(),
                     self.inner.parameter_names().join(", ")
@@ -170,6 +172,7 @@ impl Posterior {
     /// The posterior of BM1/BM2(K) of `model` on `recordings` (one or a list), as `motorcal
     /// fit` builds it for the same options.
     #[new]
+    #[allow(clippy::too_many_arguments)]
     #[pyo3(signature = (recordings, model, bm=None, k=None, prior_family="laplace", prior_decay=0.0, force=false))]
     fn new(
         py: Python<'_>,

@@ -8,7 +8,6 @@ use std::path::PathBuf;
 use motorcal::bayes::CoefficientPrior;
 use motorcal::discover::{DiscoverSettings, METRIC_ADAPTATION, discover};
 use motorcal::error::Error;
-use motorcal::io::ModelFile;
 use motorcal::paper::bench::BenchOptions;
 use motorcal::paper::sweep::SweepOptions;
 use motorcal::pipeline::{MetricAdaptation, RunSettings, SamplerKind, default_warmup};
@@ -64,7 +63,7 @@ pub fn simulate(
             "must be non-negative numbers",
         ));
     }
-    let file = model.map(|m| m.file).unwrap_or_else(ModelFile::default);
+    let file = model.map(|m| m.file).unwrap_or_default();
     let times = sample_times(t_end, samples);
     let voltage = profile.voltage(file.motor.voltage, &times);
     let motor = file
