@@ -71,6 +71,7 @@ impl BenchArgs {
             quiet: self.chains.quiet,
             coefficient_prior: coefficient_prior(self.prior_family, self.prior_decay),
             metric_adaptation: self.chains.metric_adaptation.unwrap_or_default(),
+            stop: None,
         })
     }
 }

@@ -154,6 +154,8 @@ fn laplace_run(posterior: &mut CalibrationPosterior, seed: u64) -> Result<RunOut
         divergences: 0,
         mean_accept_stat: 1.0,
         final_step_size: 0.0,
+        warmup_draws: Vec::new(),
+        warmup_records: Vec::new(),
     };
     Ok(finish_run(LAPLACE, vec![chain], &map, started))
 }

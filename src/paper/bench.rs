@@ -43,6 +43,9 @@ pub struct BenchOptions {
     pub coefficient_prior: CoefficientPrior,
     /// How HMC and NUTS tune their metric in warm-up.
     pub metric_adaptation: MetricAdaptation,
+    /// Ends the runs between transitions when set (see [`RunSettings::stop`]).
+    #[serde(skip)]
+    pub stop: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
 }
 
 impl Default for BenchOptions {
@@ -63,6 +66,7 @@ impl Default for BenchOptions {
             quiet: false,
             coefficient_prior: CoefficientPrior::default(),
             metric_adaptation: MetricAdaptation::default(),
+            stop: None,
         }
     }
 }
@@ -138,6 +142,7 @@ fn run_until_converged(
             threads: Some(threads),
             quiet: options.quiet,
             metric_adaptation: options.metric_adaptation,
+            stop: options.stop.clone(),
             ..RunSettings::default()
         };
         let run = run_sampler(posterior, &settings, label)?;

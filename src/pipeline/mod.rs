@@ -29,7 +29,7 @@ use crate::sampler::mala::{Mala, MalaAdaptation};
 use crate::sampler::metric::{Metric, MetricKind};
 use crate::sampler::metropolis::{Metropolis, PyMc3Tuning};
 use crate::sampler::nuts::{Nuts, NutsSettings};
-use crate::sampler::{Adaptation, ChainOutput, Kernel, run_chains};
+use crate::sampler::{Adaptation, ChainOutput, Kernel, RunControl, run_chains_until};
 
 use crate::error::{Error, InputError};
 
@@ -153,7 +153,7 @@ where
 {
     let bars = progress_bars(inits.len(), label, settings.quiet);
     let work = || {
-        run_chains(
+        run_chains_until(
             inits,
             &settings.chain,
             settings.seed,
@@ -162,6 +162,10 @@ where
                 Ok((posterior.clone(), k, a))
             },
             bars.as_ref().map(|(_, b)| b.as_slice()),
+            RunControl {
+                stop: settings.stop.as_deref(),
+                save_warmup: settings.save_warmup,
+            },
         )
     };
     let result = match settings.threads {

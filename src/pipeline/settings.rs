@@ -2,6 +2,8 @@
 //! of what length from which seed, and the defaults the commands share.
 
 use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
 
 use serde::{Deserialize, Serialize};
 
@@ -165,6 +167,13 @@ pub struct RunSettings {
     pub load_adaptation: Option<PathBuf>,
     /// HMC/NUTS: how warm-up tunes the metric.
     pub metric_adaptation: MetricAdaptation,
+    /// Set from outside (a user's interrupt) to end the chains between transitions with the
+    /// fatal error [`crate::sampler::STOPPED`]; `None` runs to the end.
+    #[serde(skip)]
+    pub stop: Option<Arc<AtomicBool>>,
+    /// Keep every warm-up draw in the chains' output too (the draws are the same either way).
+    #[serde(skip)]
+    pub save_warmup: bool,
 }
 
 impl Default for RunSettings {
@@ -180,6 +189,8 @@ impl Default for RunSettings {
             save_adaptation: None,
             load_adaptation: None,
             metric_adaptation: MetricAdaptation::default(),
+            stop: None,
+            save_warmup: false,
         }
     }
 }

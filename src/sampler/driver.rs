@@ -1,6 +1,7 @@
 //! The driver: warm-up then sampling for any kernel and adaptation, one chain or several in
 //! parallel, with per-chain random streams so that draws do not depend on the thread count.
 
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use indicatif::ProgressBar;
@@ -66,6 +67,21 @@ pub struct DrawRecord {
     pub energy: f64,
 }
 
+impl DrawRecord {
+    /// The columns of the transition that left the chain at `state`.
+    fn of(state: &State, info: &Info) -> Self {
+        Self {
+            lp: state.log_density,
+            accept_stat: info.accept_stat,
+            step_size: info.step_size,
+            tree_depth: info.tree_depth,
+            n_steps: info.n_steps,
+            divergent: info.divergent,
+            energy: info.energy,
+        }
+    }
+}
+
 /// Everything a chain produced.
 #[derive(Clone, Debug, Serialize)]
 pub struct ChainOutput {
@@ -88,6 +104,12 @@ pub struct ChainOutput {
     pub mean_accept_stat: f64,
     /// The step size (or proposal scale) the kernel ended with.
     pub final_step_size: f64,
+    /// Every warm-up draw (constrained) and its sampler columns, when the run's
+    /// [`RunControl::save_warmup`] asked for them; empty otherwise.
+    #[serde(skip)]
+    pub warmup_draws: Vec<Vec<f64>>,
+    #[serde(skip)]
+    pub warmup_records: Vec<DrawRecord>,
 }
 
 impl ChainOutput {
@@ -102,8 +124,8 @@ impl ChainOutput {
 #[allow(clippy::too_many_arguments)]
 pub fn run_chain<P, K, A>(
     density: P,
-    mut kernel: K,
-    mut adaptation: A,
+    kernel: K,
+    adaptation: A,
     init: &[f64],
     settings: &ChainSettings,
     rng: &mut ChaCha8Rng,
@@ -115,6 +137,62 @@ where
     K: Kernel<Counted<P>>,
     A: Adaptation<K>,
 {
+    let chain_run = ChainRun {
+        init,
+        settings,
+        chain,
+        progress,
+        control: RunControl::default(),
+    };
+    run_chain_until(density, kernel, adaptation, rng, chain_run)
+}
+
+/// The message of a run stopped by its stop flag.
+pub const STOPPED: &str = "stopped on request";
+
+/// What a caller asks of a run beside its settings: a flag that stops it, and whether the
+/// warm-up's draws are kept too. Neither changes a draw.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RunControl<'a> {
+    /// Checked between transitions: once set, the run ends with the fatal error [`STOPPED`].
+    pub stop: Option<&'a AtomicBool>,
+    /// Keep every warm-up draw in [`ChainOutput::warmup_draws`] and `warmup_records`.
+    pub save_warmup: bool,
+}
+
+/// One chain's place in a run.
+struct ChainRun<'a> {
+    init: &'a [f64],
+    settings: &'a ChainSettings,
+    chain: usize,
+    progress: Option<&'a ProgressBar>,
+    control: RunControl<'a>,
+}
+
+/// [`run_chain`] under a [`RunControl`].
+fn run_chain_until<P, K, A>(
+    density: P,
+    mut kernel: K,
+    mut adaptation: A,
+    rng: &mut ChaCha8Rng,
+    run: ChainRun<'_>,
+) -> Result<(ChainOutput, K), DensityError>
+where
+    P: LogDensity,
+    K: Kernel<Counted<P>>,
+    A: Adaptation<K>,
+{
+    let ChainRun {
+        init,
+        settings,
+        chain,
+        progress,
+        control,
+    } = run;
+    let check = || match control.stop {
+        Some(flag) if flag.load(Ordering::Relaxed) => Err(DensityError::fatal(STOPPED)),
+        _ => Ok(()),
+    };
     settings.validate().map_err(DensityError::fatal)?;
     // The warm-up's time includes the initial point's evaluation, as its counts do.
     let warmup_watch = Stopwatch::start();
@@ -130,9 +208,17 @@ where
     let reporter = Reporter::new(progress, total);
 
     let mut divergences_warmup = 0usize;
+    let mut constrained = Vec::new();
+    let (mut warmup_draws, mut warmup_records) = (Vec::new(), Vec::new());
     for iteration in 0..settings.warmup {
+        check()?;
         let info = kernel.step(&mut density, &mut state, rng)?;
         divergences_warmup += info.divergent as usize;
+        if control.save_warmup {
+            density.constrain(&state.x, &mut constrained);
+            warmup_draws.push(constrained.clone());
+            warmup_records.push(DrawRecord::of(&state, &info));
+        }
         adaptation.observe(&mut kernel, &state, &info, iteration, settings.warmup);
         reporter.tick(iteration, &info, divergences_warmup, "warm-up");
     }
@@ -145,10 +231,10 @@ where
     let mut records = Vec::with_capacity(settings.kept());
     let mut divergences = 0usize;
     let mut accept_sum = 0.0;
-    let mut constrained = Vec::new();
     let mut last_step_size = f64::NAN;
     let sampling_watch = Stopwatch::start();
     for i in 0..settings.draws {
+        check()?;
         let info = kernel.step(&mut density, &mut state, rng)?;
         divergences += info.divergent as usize;
         accept_sum += info.accept_stat;
@@ -157,15 +243,7 @@ where
             density.constrain(&state.x, &mut constrained);
             draws.push(constrained.clone());
             unconstrained.push(state.x.clone());
-            records.push(DrawRecord {
-                lp: state.log_density,
-                accept_stat: info.accept_stat,
-                step_size: info.step_size,
-                tree_depth: info.tree_depth,
-                n_steps: info.n_steps,
-                divergent: info.divergent,
-                energy: info.energy,
-            });
+            records.push(DrawRecord::of(&state, &info));
         }
         reporter.tick(settings.warmup + i, &info, divergences, "sampling");
     }
@@ -184,6 +262,8 @@ where
         divergences,
         mean_accept_stat: accept_sum / settings.draws as f64,
         final_step_size: last_step_size,
+        warmup_draws,
+        warmup_records,
     };
     Ok((output, kernel))
 }
@@ -212,6 +292,25 @@ where
     A: Adaptation<K>,
     F: Fn(usize) -> Result<(P, K, A), DensityError> + Sync,
 {
+    run_chains_until(inits, settings, seed, make, progress, RunControl::default())
+}
+
+/// [`run_chains`] under a [`RunControl`]: stopped soon after its flag is set (every chain
+/// checks it between transitions), keeping the warm-up's draws if asked.
+pub fn run_chains_until<P, K, A, F>(
+    inits: &[Vec<f64>],
+    settings: &ChainSettings,
+    seed: u64,
+    make: F,
+    progress: Option<&[ProgressBar]>,
+    control: RunControl<'_>,
+) -> Result<Vec<(ChainOutput, K)>, DensityError>
+where
+    P: LogDensity,
+    K: Kernel<Counted<P>> + Send,
+    A: Adaptation<K>,
+    F: Fn(usize) -> Result<(P, K, A), DensityError> + Sync,
+{
     inits
         .par_iter()
         .enumerate()
@@ -219,9 +318,14 @@ where
             let (density, kernel, adaptation) = make(chain)?;
             let mut rng = chain_rng(seed, chain);
             let bar = progress.and_then(|bars| bars.get(chain));
-            run_chain(
-                density, kernel, adaptation, init, settings, &mut rng, chain, bar,
-            )
+            let chain_run = ChainRun {
+                init,
+                settings,
+                chain,
+                progress: bar,
+                control,
+            };
+            run_chain_until(density, kernel, adaptation, &mut rng, chain_run)
         })
         .collect()
 }

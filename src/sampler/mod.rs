@@ -22,7 +22,10 @@ pub mod targets;
 pub mod welford;
 
 pub use cost::PhaseCost;
-pub use driver::{ChainOutput, ChainSettings, DrawRecord, run_chain, run_chains};
+pub use driver::{
+    ChainOutput, ChainSettings, DrawRecord, RunControl, STOPPED, run_chain, run_chains,
+    run_chains_until,
+};
 
 use rand_chacha::ChaCha8Rng;
 
