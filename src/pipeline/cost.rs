@@ -219,6 +219,8 @@ pub(crate) mod tests {
             divergences: 0,
             map_log_density: 0.0,
             log_evidence_laplace: 0.0,
+            khat: None,
+            fell_back: false,
         }
     }
 
