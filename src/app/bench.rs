@@ -161,7 +161,7 @@ pub fn read_records(path: &Path) -> Result<Vec<BenchRecord>, AppError> {
 
 fn format_record(r: &BenchRecord) -> String {
     format!(
-        "{:<20} K={:<3} t={:<2} draws {:>6}  min ESS {:>8.0}  ESS/CPU-s {:>9.2} sampling, {:>9.2} all  ESS/{} {:>9.5}, {:>9.5} all  R-hat {:>6.3}  wall {:>7.1} s{}",
+        "{:<20} K={:<3} t={:<2} draws {:>6}  min ESS {:>8.0}  ESS/CPU-s {:>9.2} sampling, {:>9.2} all  ESS/{} {:>9.5}, {:>9.5} all  ESS/solve-eq {:>7.4}  R-hat {:>6.3}  wall {:>7.1} s{}",
         r.sampler,
         r.k,
         r.threads,
@@ -172,6 +172,7 @@ fn format_record(r: &BenchRecord) -> String {
         r.cost.eval_kind,
         r.cost.min_ess_per_eval,
         r.cost.min_ess_per_all_evals,
+        r.cost.min_ess_per_solve,
         r.max_rhat,
         r.cost.wall_s,
         if r.converged {
@@ -196,7 +197,7 @@ fn khat_note(r: &BenchRecord) -> String {
 pub fn format_table(records: &[BenchRecord]) -> String {
     let mut out = String::new();
     out.push_str(&format!(
-        "{:<20} {:>3} {:>3} {:>7} {:>9} {:>11} {:>11} {:>11} {:>11} {:>9} {:>7} {:>8} {:>8} {:>8} {:>7}\n",
+        "{:<20} {:>3} {:>3} {:>7} {:>9} {:>11} {:>11} {:>11} {:>11} {:>9} {:>10} {:>7} {:>8} {:>8} {:>8} {:>7}\n",
         "sampler",
         "K",
         "thr",
@@ -207,6 +208,7 @@ pub fn format_table(records: &[BenchRecord]) -> String {
         "ESS/eval",
         "ESS/all-ev",
         "eval",
+        "ESS/solve",
         "R-hat",
         "CPU s",
         "wall s",
@@ -215,7 +217,7 @@ pub fn format_table(records: &[BenchRecord]) -> String {
     ));
     for r in records {
         out.push_str(&format!(
-            "{:<20} {:>3} {:>3} {:>7} {:>9.0} {:>11.2} {:>11.2} {:>11.5} {:>11.5} {:>9} {:>7.3} {:>8.1} {:>8.1} {:>8} {:>7}\n",
+            "{:<20} {:>3} {:>3} {:>7} {:>9.0} {:>11.2} {:>11.2} {:>11.5} {:>11.5} {:>9} {:>10.4} {:>7.3} {:>8.1} {:>8.1} {:>8} {:>7}\n",
             r.sampler,
             r.k,
             r.threads,
@@ -226,6 +228,7 @@ pub fn format_table(records: &[BenchRecord]) -> String {
             r.cost.min_ess_per_eval,
             r.cost.min_ess_per_all_evals,
             r.cost.eval_kind,
+            r.cost.min_ess_per_solve,
             r.max_rhat,
             r.cost.total_cpu_s,
             r.cost.wall_s,
@@ -305,12 +308,13 @@ fn write_records(options: &Outputs, records: &[BenchRecord]) -> Result<(), AppEr
         "sampler,k,threads,chains,warmup,draws,min_ess_bulk,max_rhat,converged,lower_bound,divergences,\
          wall_s,map_wall_s,map_cpu_s,warmup_wall_s,warmup_cpu_s,sampling_wall_s,sampling_cpu_s,total_cpu_s,\
          eval_kind,evaluations,all_evaluations,\
-         min_ess_per_s,min_ess_per_total_s,min_ess_per_wall_s,min_ess_per_eval,min_ess_per_all_evals,prior,metric_adaptation,khat,fell_back\n",
+         min_ess_per_s,min_ess_per_total_s,min_ess_per_wall_s,min_ess_per_eval,min_ess_per_all_evals,prior,metric_adaptation,khat,fell_back,\
+         plain_solves,dual_solves,solve_directions,solve_equivalents,min_ess_per_solve\n",
     );
     for r in records {
         let c = &r.cost;
         csv.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},\"{}\",{},{},{}\n",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},\"{}\",{},{},{},{},{},{},{},{}\n",
             r.sampler,
             r.k,
             r.threads,
@@ -341,7 +345,12 @@ fn write_records(options: &Outputs, records: &[BenchRecord]) -> Result<(), AppEr
             r.prior,
             r.metric_adaptation,
             r.khat.map_or(String::new(), |k| k.to_string()),
-            r.fell_back
+            r.fell_back,
+            c.solves.plain,
+            c.solves.dual,
+            c.solves.directions,
+            c.solves.equivalents(),
+            c.min_ess_per_solve
         ));
     }
     crate::io::write_atomically(&options.out.join("bench.csv"), csv.as_bytes())?;
