@@ -281,6 +281,24 @@ pub(crate) mod tests {
     }
 
     #[test]
+    fn solves_are_counted_over_the_whole_cost_a_dual_solve_with_its_directions() {
+        let mut r = run(600.0);
+        r.map.solves = SolveCount {
+            plain: 10,
+            dual: 20,
+            directions: 20,
+        };
+        r.sampling.solves = SolveCount {
+            plain: 500,
+            dual: 0,
+            directions: 0,
+        };
+        let cost = RunCost::of(&r, false);
+        assert_eq!(cost.solves.equivalents(), 10 + 20 * 2 + 500);
+        assert_eq!(cost.min_ess_per_solve, 600.0 / 550.0);
+    }
+
+    #[test]
     fn the_cost_is_written_flat_with_the_keys_it_always_had() {
         let cost = RunCost::of(&run(850.0), true);
         let text = serde_json::to_string(&cost).unwrap();
@@ -308,6 +326,12 @@ pub(crate) mod tests {
                 "min_ess_per_wall_s",
                 "min_ess_per_eval",
                 "min_ess_per_all_evals",
+                // Added with the solve count; older files read them as zero.
+                "plain_solves",
+                "dual_solves",
+                "solve_directions",
+                "solve_equivalents",
+                "min_ess_per_solve",
             ]
         );
         assert!(text.contains(r#""map_cpu_s":0.5,"#), "{text}");
