@@ -75,6 +75,63 @@ pub trait LogDensity {
     fn blocks(&self) -> Vec<Range<usize>> {
         (0..self.dim()).map(|i| i..i + 1).collect()
     }
+
+    /// The ODE solves this density has made (none for a closed-form density).
+    fn solves(&self) -> SolveCount {
+        SolveCount::default()
+    }
+}
+
+/// ODE solves made: plain f64 solves, and dual-number solves with the number of derivative
+/// directions they carried (θ's dimension each). A density evaluation that the posterior's
+/// cache serves makes none.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub struct SolveCount {
+    pub plain: u64,
+    pub dual: u64,
+    pub directions: u64,
+}
+
+impl SolveCount {
+    /// Solve-equivalents: a plain solve is one, a dual solve carrying n directions is 1 + n
+    /// (forward mode integrates the value and each direction alongside it; the yardstick,
+    /// `examples/minimal_dopri5.rs`, prints what one costs against a plain solve).
+    pub fn equivalents(&self) -> u64 {
+        self.plain + self.dual + self.directions
+    }
+}
+
+impl std::ops::Add for SolveCount {
+    type Output = Self;
+    fn add(self, o: Self) -> Self {
+        Self {
+            plain: self.plain + o.plain,
+            dual: self.dual + o.dual,
+            directions: self.directions + o.directions,
+        }
+    }
+}
+
+impl std::ops::Sub for SolveCount {
+    type Output = Self;
+    fn sub(self, o: Self) -> Self {
+        Self {
+            plain: self.plain - o.plain,
+            dual: self.dual - o.dual,
+            directions: self.directions - o.directions,
+        }
+    }
+}
+
+/// A counter that a clone does not inherit: a cloned density is a new evaluator (each chain
+/// owns one) and counts its own solves from zero.
+#[derive(Debug, Default)]
+pub struct SolveCounter(pub SolveCount);
+
+impl Clone for SolveCounter {
+    fn clone(&self) -> Self {
+        Self::default()
+    }
 }
 
 /// A log density that also offers a positive-definite metric: the expected Fisher information
@@ -146,6 +203,9 @@ impl<P: LogDensity> LogDensity for Counted<P> {
     }
     fn blocks(&self) -> Vec<Range<usize>> {
         self.inner.blocks()
+    }
+    fn solves(&self) -> SolveCount {
+        self.inner.solves()
     }
 }
 

@@ -474,6 +474,7 @@ fn draws_round_trip_exactly_through_cmdstan_files() {
                 n_leapfrog: 15,
                 divergent: draw == 3,
                 energy: 1240.25,
+                weight: None,
             };
             writer.write_draw(&sampler, &values).unwrap();
         }

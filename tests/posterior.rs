@@ -190,3 +190,33 @@ fn laplace_evidence_of_bm1_agrees_with_importance_sampling() {
     );
     assert!((log_z - map.log_evidence_laplace).abs() < 0.1);
 }
+
+#[test]
+fn solves_are_counted_where_the_cache_misses_a_gradient_with_its_directions() {
+    use motorcal::density::SolveCount;
+    let mut searched = paper_posterior(&ModelSettings::bm2(3), 1);
+    let mut x = searched.initial_point().unwrap();
+    // A clone is a new evaluator: it counts from zero.
+    let mut post = searched.clone();
+    assert_eq!(post.solves(), SolveCount::default());
+    let count = |plain, dual| SolveCount {
+        plain,
+        dual,
+        directions: dual,
+    };
+    // The clone keeps the cache, not the count: a new R (index 0) makes the first solve.
+    x[0] *= 1.001;
+    post.log_density(&x).unwrap();
+    assert_eq!(post.solves(), count(1, 0));
+    // Only a coefficient moves: the cached solve serves it.
+    let last = x.len() - 1;
+    x[last] += 0.1;
+    post.log_density(&x).unwrap();
+    assert_eq!(post.solves(), count(1, 0));
+    let mut grad = vec![0.0; x.len()];
+    post.log_density_and_gradient(&x, &mut grad).unwrap();
+    assert_eq!(post.solves(), count(1, 1));
+    x[0] *= 1.001;
+    post.log_density(&x).unwrap();
+    assert_eq!(post.solves(), count(2, 1));
+}

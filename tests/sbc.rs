@@ -34,7 +34,7 @@ use motorcal::diagnostics::ess_bulk;
 use motorcal::forward::ForwardModel;
 use motorcal::motor::{MotorModel, MotorParameters, VoltageInput};
 use motorcal::ode::SolverSettings;
-use motorcal::pipeline::{RunSettings, SamplerKind, run_sampler};
+use motorcal::pipeline::{MetricAdaptation, RunSettings, SamplerKind, default_warmup, run_sampler};
 use motorcal::sampler::ChainSettings;
 use motorcal::sampler::driver::chain_rng;
 use motorcal::synthetic::{generate, sample_times};
@@ -248,6 +248,9 @@ struct Replication {
     thin: usize,
     min_ess: f64,
     divergences: usize,
+    /// laplace-is: its k̂, and whether it fell back to NUTS.
+    khat: Option<f64>,
+    fell_back: bool,
 }
 
 fn rank(truth: f64, draws: impl Iterator<Item = f64>) -> usize {
@@ -256,7 +259,7 @@ fn rank(truth: f64, draws: impl Iterator<Item = f64>) -> usize {
 
 /// Replication `r`: its prior draw, noise and chains all come from stream `r` of `SEED`, so
 /// it gives the same result whichever thread runs it and however many run.
-fn replicate(r: usize) -> Replication {
+fn replicate(r: usize, sampler: SamplerKind) -> Replication {
     let mut rng = chain_rng(SEED, r);
     let truth = draw_from_prior(&mut rng);
     let noise_seed = rng.next_u64();
@@ -279,10 +282,14 @@ fn replicate(r: usize) -> Replication {
     let mut n_draws = FIRST_DRAWS;
     loop {
         let settings = RunSettings {
-            sampler: SamplerKind::NutsDense,
+            sampler,
             chains: 1,
             chain: ChainSettings {
-                warmup: WARMUP,
+                warmup: if sampler == SamplerKind::NutsDense {
+                    WARMUP
+                } else {
+                    default_warmup(sampler, MetricAdaptation::Laplace)
+                },
                 draws: n_draws,
                 keep: None,
             },
@@ -294,10 +301,12 @@ fn replicate(r: usize) -> Replication {
             .unwrap_or_else(|e| panic!("replication {r} (θ̃ = {truth:?}): {e}"));
         let chain = &run.chains[0];
         let columns: Vec<Vec<f64>> = (0..3).map(|j| chain.column(j)).collect();
+        // For laplace-is the run's min ESS is also capped by its weights' ESS: resampled
+        // draws repeat, and thinning to the column's ESS alone would keep too many copies.
         let min_ess = columns
             .iter()
             .map(|c| ess_bulk(&[c]))
-            .fold(f64::INFINITY, f64::min);
+            .fold(run.min_ess_bulk, f64::min);
         // Keep every `thin`-th draw, with `thin` ≥ draws/ESS, so that the kept draws are about
         // as many as the chain's independent ones.
         let thin = (n_draws as f64 / min_ess).ceil().max(1.0) as usize;
@@ -315,6 +324,8 @@ fn replicate(r: usize) -> Replication {
             thin,
             min_ess,
             divergences: run.divergences,
+            khat: run.khat,
+            fell_back: run.fell_back,
         };
         for j in 0..3 {
             let draws: Vec<f64> = kept.iter().map(|&i| columns[j][i]).collect();
@@ -367,10 +378,13 @@ fn p_values(
         .collect()
 }
 
-fn calibration(replications: usize, bins: usize) {
+fn calibration(replications: usize, bins: usize, sampler: SamplerKind) -> String {
     let started = Instant::now();
     // Ordered by r whatever the thread count: the outcome does not depend on it.
-    let reps: Vec<Replication> = (0..replications).into_par_iter().map(replicate).collect();
+    let reps: Vec<Replication> = (0..replications)
+        .into_par_iter()
+        .map(|r| replicate(r, sampler))
+        .collect();
     let seconds = started.elapsed().as_secs_f64();
 
     let divergences: usize = reps.iter().map(|r| r.divergences).sum();
@@ -383,24 +397,40 @@ fn calibration(replications: usize, bins: usize) {
         .fold((f64::INFINITY, 0.0f64), |(lo, hi), s| {
             (lo.min(s), hi.max(s))
         });
-    eprintln!(
-        "SBC, NUTS dense on BM1: {replications} replications × {L} draws, {bins} bins, {seconds:.1} s; \
+    let mut report = format!(
+        "SBC, {} on BM1: {replications} replications × {L} draws, {bins} bins, {seconds:.1} s; \
          σ̃ from {:.3} to {:.1}; thinning mean {mean_thin:.2}, lowest ESS {min_ess:.0}, \
-         longest chain {longest}; {divergences} divergences",
-        sigma_range.0, sigma_range.1
+         longest chain {longest}; {divergences} divergences\n",
+        sampler.name(),
+        sigma_range.0,
+        sigma_range.1
     );
+    let khats: Vec<f64> = reps.iter().filter_map(|r| r.khat).collect();
+    if !khats.is_empty() {
+        let mut sorted = khats.clone();
+        sorted.sort_by(f64::total_cmp);
+        report.push_str(&format!(
+            "k̂: median {:.3}, max {:.3}, {} of {} above 0.5, {} fell back to NUTS\n",
+            sorted[sorted.len() / 2],
+            sorted[sorted.len() - 1],
+            sorted.iter().filter(|&&k| k > 0.5).count(),
+            sorted.len(),
+            reps.iter().filter(|r| r.fell_back).count()
+        ));
+    }
 
     let threshold = ALPHA / PARAMETERS.len() as f64;
     let sampled = p_values(&reps, bins, |r| r.ranks);
     let shifted = p_values(&reps, bins, |r| r.shifted);
     let narrowed = p_values(&reps, bins, |r| r.narrowed);
     for (j, name) in PARAMETERS.iter().enumerate() {
-        eprintln!(
+        report.push_str(&format!(
             "{name:>12}: p = {:.4} {:?}; shifted by 1 sd p = {:.1e} {:?}; \
-             shrunk to sd/3 p = {:.1e} {:?}",
+             shrunk to sd/3 p = {:.1e} {:?}\n",
             sampled[j].0, sampled[j].1, shifted[j].0, shifted[j].1, narrowed[j].0, narrowed[j].1
-        );
+        ));
     }
+    eprint!("{report}");
     let mut failures = Vec::new();
     for (j, name) in PARAMETERS.iter().enumerate() {
         // Written so that a NaN p-value fails too.
@@ -428,13 +458,25 @@ fn calibration(replications: usize, bins: usize) {
         }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
+    report
 }
 
 /// 100 replications in 10 bins (10 expected per bin), about 15 s: coarse, but a posterior off
 /// by one sd or three times too narrow fails it by orders of magnitude.
 #[test]
 fn nuts_ranks_the_truth_uniformly_in_100_replications() {
-    calibration(100, 10);
+    calibration(100, 10, SamplerKind::NutsDense);
+}
+
+/// The same 100 replications for the samplers that draw from the Laplace approximation.
+#[test]
+fn independence_ranks_the_truth_uniformly_in_100_replications() {
+    calibration(100, 10, SamplerKind::Independence);
+}
+
+#[test]
+fn laplace_is_ranks_the_truth_uniformly_in_100_replications() {
+    calibration(100, 10, SamplerKind::LaplaceIs);
 }
 
 /// Ten times Talts et al.'s 100: 1000 replications in 20 bins (50 expected per bin), which
@@ -442,5 +484,23 @@ fn nuts_ranks_the_truth_uniformly_in_100_replications() {
 #[test]
 #[ignore]
 fn nuts_ranks_the_truth_uniformly_in_1000_replications() {
-    calibration(1000, 20);
+    calibration(1000, 20, SamplerKind::NutsDense);
+}
+
+/// 1000 replications of each Laplace sampler; the report is written to
+/// papers/laplace-samplers/sbc_bm1.txt.
+#[test]
+#[ignore]
+fn the_laplace_samplers_rank_the_truth_uniformly_in_1000_replications() {
+    let mut report =
+        String::from("# cargo test --release --test sbc -- --ignored the_laplace_samplers\n");
+    for sampler in [SamplerKind::Independence, SamplerKind::LaplaceIs] {
+        report.push_str(&calibration(1000, 20, sampler));
+    }
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/papers/laplace-samplers/sbc_bm1.txt"
+    );
+    std::fs::create_dir_all(std::path::Path::new(path).parent().unwrap()).unwrap();
+    std::fs::write(path, report).unwrap();
 }

@@ -127,6 +127,12 @@ impl ValueEnum for SamplerKind {
             SamplerKind::FisherMala => {
                 "Simplified manifold MALA with the Gauss–Newton (Fisher) metric"
             }
+            SamplerKind::Independence => {
+                "Independence Metropolis–Hastings from a Student-t at the MAP with the Laplace covariance"
+            }
+            SamplerKind::LaplaceIs => {
+                "Importance sampling from that Student-t, Pareto-smoothed; NUTS when k̂ > 0.7"
+            }
         };
         Some(PossibleValue::new(self.name()).help(help))
     }

@@ -162,7 +162,7 @@ pub fn read_records(path: &Path) -> Result<Vec<BenchRecord>, AppError> {
 
 fn format_record(r: &BenchRecord) -> String {
     format!(
-        "{:<20} K={:<3} t={:<2} draws {:>6}  min ESS {:>8.0}  ESS/CPU-s {:>9.2} sampling, {:>9.2} all  ESS/{} {:>9.5}, {:>9.5} all  R-hat {:>6.3}  wall {:>7.1} s{}",
+        "{:<20} K={:<3} t={:<2} draws {:>6}  min ESS {:>8.0}  ESS/CPU-s {:>9.2} sampling, {:>9.2} all  ESS/{} {:>9.5}, {:>9.5} all  ESS/solve-eq {:>7.4}  R-hat {:>6.3}  wall {:>7.1} s{}",
         r.sampler,
         r.k,
         r.threads,
@@ -173,6 +173,7 @@ fn format_record(r: &BenchRecord) -> String {
         r.cost.eval_kind,
         r.cost.min_ess_per_eval,
         r.cost.min_ess_per_all_evals,
+        r.cost.min_ess_per_solve,
         r.max_rhat,
         r.cost.wall_s,
         if r.converged {
@@ -180,7 +181,16 @@ fn format_record(r: &BenchRecord) -> String {
         } else {
             "  NOT CONVERGED (bound)"
         }
-    )
+    ) + &khat_note(r)
+}
+
+/// laplace-is's k̂ and whether it fell back to NUTS; nothing for the MCMC samplers.
+fn khat_note(r: &BenchRecord) -> String {
+    match r.khat {
+        Some(k) if r.fell_back => format!("  k̂ {k:.3} (fell back to NUTS)"),
+        Some(k) => format!("  k̂ {k:.3}"),
+        None => String::new(),
+    }
 }
 
 /// The table, and the ratios of the best gradient sampler to each baseline per K: per CPU
@@ -188,7 +198,7 @@ fn format_record(r: &BenchRecord) -> String {
 pub fn format_table(records: &[BenchRecord]) -> String {
     let mut out = String::new();
     out.push_str(&format!(
-        "{:<20} {:>3} {:>3} {:>7} {:>9} {:>11} {:>11} {:>11} {:>11} {:>9} {:>7} {:>8} {:>8} {:>8}\n",
+        "{:<20} {:>3} {:>3} {:>7} {:>9} {:>11} {:>11} {:>11} {:>11} {:>9} {:>10} {:>7} {:>8} {:>8} {:>8} {:>7}\n",
         "sampler",
         "K",
         "thr",
@@ -199,14 +209,16 @@ pub fn format_table(records: &[BenchRecord]) -> String {
         "ESS/eval",
         "ESS/all-ev",
         "eval",
+        "ESS/solve",
         "R-hat",
         "CPU s",
         "wall s",
-        "conv"
+        "conv",
+        "k̂"
     ));
     for r in records {
         out.push_str(&format!(
-            "{:<20} {:>3} {:>3} {:>7} {:>9.0} {:>11.2} {:>11.2} {:>11.5} {:>11.5} {:>9} {:>7.3} {:>8.1} {:>8.1} {:>8}\n",
+            "{:<20} {:>3} {:>3} {:>7} {:>9.0} {:>11.2} {:>11.2} {:>11.5} {:>11.5} {:>9} {:>10.4} {:>7.3} {:>8.1} {:>8.1} {:>8} {:>7}\n",
             r.sampler,
             r.k,
             r.threads,
@@ -217,10 +229,16 @@ pub fn format_table(records: &[BenchRecord]) -> String {
             r.cost.min_ess_per_eval,
             r.cost.min_ess_per_all_evals,
             r.cost.eval_kind,
+            r.cost.min_ess_per_solve,
             r.max_rhat,
             r.cost.total_cpu_s,
             r.cost.wall_s,
-            if r.converged { "yes" } else { "no" }
+            if r.converged { "yes" } else { "no" },
+            match r.khat {
+                Some(k) if r.fell_back => format!("{k:.2}→NUTS"),
+                Some(k) => format!("{k:.3}"),
+                None => "-".into(),
+            }
         ));
     }
     let mut keys: Vec<(usize, usize)> = records.iter().map(|r| (r.k, r.threads)).collect();
@@ -237,7 +255,30 @@ pub fn format_table(records: &[BenchRecord]) -> String {
             .filter(|r| r.cost.eval_kind == "gradient" && r.converged)
             .max_by(|a, b| a.cost.min_ess_per_s.total_cmp(&b.cost.min_ess_per_s));
         let Some(best) = best else { continue };
-        for base in here.iter().filter(|r| r.cost.eval_kind == "density") {
+        // The random walks are the baselines; the Laplace samplers are compared the other way.
+        let random_walk = |r: &&&BenchRecord| {
+            matches!(
+                r.sampler.parse::<SamplerKind>(),
+                Ok(SamplerKind::Metropolis | SamplerKind::AdaptiveMetropolis)
+            )
+        };
+        let laplace = |r: &&&BenchRecord| {
+            matches!(
+                r.sampler.parse::<SamplerKind>(),
+                Ok(SamplerKind::Independence | SamplerKind::LaplaceIs)
+            )
+        };
+        for new in here.iter().filter(laplace) {
+            out.push_str(&format!(
+                "K={k:<3} threads={threads}: {} / {} = {}× per CPU-s of sampling, {}× of the whole cost{}\n",
+                new.sampler,
+                best.sampler,
+                ratio_2sf(new.cost.min_ess_per_s / best.cost.min_ess_per_s),
+                ratio_2sf(new.cost.min_ess_per_total_s / best.cost.min_ess_per_total_s),
+                if new.converged { "" } else { " (not converged)" }
+            ));
+        }
+        for base in here.iter().filter(random_walk) {
             let bound = if base.lower_bound { "≥ " } else { "" };
             out.push_str(&format!(
                 "K={k:<3} threads={threads}: {} / {} = {bound}{}× per CPU-s of sampling, {bound}{}× of the whole cost{}\n",
@@ -268,12 +309,13 @@ fn write_records(options: &Outputs, records: &[BenchRecord]) -> Result<(), AppEr
         "sampler,k,threads,chains,warmup,draws,min_ess_bulk,max_rhat,converged,lower_bound,divergences,\
          wall_s,map_wall_s,map_cpu_s,warmup_wall_s,warmup_cpu_s,sampling_wall_s,sampling_cpu_s,total_cpu_s,\
          eval_kind,evaluations,all_evaluations,\
-         min_ess_per_s,min_ess_per_total_s,min_ess_per_wall_s,min_ess_per_eval,min_ess_per_all_evals,prior,metric_adaptation\n",
+         min_ess_per_s,min_ess_per_total_s,min_ess_per_wall_s,min_ess_per_eval,min_ess_per_all_evals,prior,metric_adaptation,khat,fell_back,\
+         plain_solves,dual_solves,solve_directions,solve_equivalents,min_ess_per_solve\n",
     );
     for r in records {
         let c = &r.cost;
         csv.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},\"{}\",{}\n",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},\"{}\",{},{},{},{},{},{},{},{}\n",
             r.sampler,
             r.k,
             r.threads,
@@ -302,7 +344,14 @@ fn write_records(options: &Outputs, records: &[BenchRecord]) -> Result<(), AppEr
             c.min_ess_per_eval,
             c.min_ess_per_all_evals,
             r.prior,
-            r.metric_adaptation
+            r.metric_adaptation,
+            r.khat.map_or(String::new(), |k| k.to_string()),
+            r.fell_back,
+            c.solves.plain,
+            c.solves.dual,
+            c.solves.directions,
+            c.solves.equivalents(),
+            c.min_ess_per_solve
         ));
     }
     crate::io::write_atomically(&options.out.join("bench.csv"), csv.as_bytes())?;
@@ -407,7 +456,7 @@ mod tests {
             ),
             "{table}"
         );
-        assert!(table.contains(" no\n"), "{table}");
+        assert!(table.contains(" no       -\n"), "{table}");
         // Without a converged gradient sampler there is no ratio to print.
         let unconverged_gradient = BenchRecord {
             converged: false,

@@ -96,6 +96,10 @@ pub struct RunArgs {
     /// HMC/NUTS: start from a saved adaptation and skip adapting (use with a short --warmup).
     #[arg(long)]
     pub load_adaptation: Option<PathBuf>,
+    /// laplace-is: keep the importance sampling even when k̂ > 0.7 says the Laplace
+    /// approximation cannot be trusted (default: fall back to NUTS).
+    #[arg(long)]
+    pub no_fallback: bool,
 }
 
 impl RunArgs {
@@ -105,6 +109,7 @@ impl RunArgs {
         run.threads = self.threads;
         run.save_adaptation = self.save_adaptation.clone();
         run.load_adaptation = self.load_adaptation.clone();
+        run.fallback = !self.no_fallback;
         run
     }
 }
@@ -175,6 +180,10 @@ pub struct FitReport {
     pub max_rhat: Option<f64>,
     pub min_ess_bulk: Option<f64>,
     pub divergences: Option<usize>,
+    /// laplace-is: the Pareto shape k̂ of its importance weights (null for the MCMC samplers).
+    pub khat: Option<f64>,
+    /// laplace-is: k̂ > 0.7 and NUTS drew instead.
+    pub fell_back: bool,
     pub wall_seconds: Option<f64>,
     pub outputs: Vec<String>,
     /// What the plausibility check found, when `--force` went on regardless.
@@ -243,6 +252,8 @@ pub fn fit(options: &FitOptions) -> Result<FitReport, AppError> {
         max_rhat: None,
         min_ess_bulk: None,
         divergences: None,
+        khat: None,
+        fell_back: false,
         wall_seconds: None,
         outputs: Vec::new(),
         implausible,
@@ -258,6 +269,8 @@ pub fn fit(options: &FitOptions) -> Result<FitReport, AppError> {
         report.max_rhat = Some(run.max_rhat);
         report.min_ess_bulk = Some(run.min_ess_bulk);
         report.divergences = Some(run.divergences);
+        report.khat = run.khat;
+        report.fell_back = run.fell_back;
         report.wall_seconds = Some(run.wall_seconds);
         report.summaries = run.summaries;
     }
@@ -387,6 +400,9 @@ pub fn format_report(report: &FitReport) -> String {
             report.divergences.unwrap_or(0),
             report.wall_seconds.unwrap_or(f64::NAN)
         ));
+        if let Some(khat) = report.khat {
+            out.push_str(&khat_line(khat, report.fell_back));
+        }
         out.push_str(&super::summarize::format_table(&report.summaries));
     }
     for f in &report.fit {
@@ -399,4 +415,24 @@ pub fn format_report(report: &FitReport) -> String {
         out.push_str(&format!("wrote {o}\n"));
     }
     out
+}
+
+/// What k̂ says about the Laplace approximation, and what the run did about it.
+pub fn khat_line(khat: f64, fell_back: bool) -> String {
+    use crate::diagnostics::{KHAT_GOOD, KHAT_UNRELIABLE};
+    let verdict = if khat <= KHAT_GOOD {
+        "the Laplace approximation is good"
+    } else if khat <= KHAT_UNRELIABLE {
+        "the Laplace approximation is usable, the estimates converge slowly"
+    } else {
+        "the Laplace approximation cannot be trusted"
+    };
+    let action = if fell_back {
+        "; NUTS drew instead"
+    } else if khat > KHAT_UNRELIABLE || khat.is_nan() {
+        "; kept as asked (--no-fallback)"
+    } else {
+        ""
+    };
+    format!("importance weights: Pareto k̂ = {khat:.3}: {verdict}{action}\n")
 }

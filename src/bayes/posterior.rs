@@ -13,7 +13,7 @@ use nalgebra::DMatrix;
 
 use super::calibrated::{CalibratedParameter, PriorInU};
 use super::settings::ModelSettings;
-use crate::density::DensityError;
+use crate::density::{DensityError, SolveCounter};
 use crate::forward::ForwardModel;
 use crate::parameter::Prior;
 
@@ -92,6 +92,8 @@ struct RecordTerm {
     /// variable-at-a-time Metropolis does exactly that, several times a sweep).
     previous: Solve,
     residual: Vec<f64>,
+    /// The solves this record's cache did not serve.
+    solves: SolveCounter,
 }
 
 impl RecordTerm {
@@ -106,6 +108,12 @@ impl RecordTerm {
         }
         let solve = &mut self.current;
         solve.kind = Cached::Nothing;
+        if sensitivities {
+            self.solves.0.dual += 1;
+            self.solves.0.directions += theta.len() as u64;
+        } else {
+            self.solves.0.plain += 1;
+        }
         let result = if sensitivities {
             self.forward
                 .simulate_with_sensitivities(theta, &mut solve.outputs, &mut solve.jacobian)
@@ -287,6 +295,7 @@ impl CalibrationPosterior {
                 current: Solve::empty(n_out, n_par),
                 previous: Solve::empty(n_out, n_par),
                 residual: vec![0.0; m],
+                solves: SolveCounter::default(),
                 forward,
             });
         }

@@ -19,10 +19,12 @@
 mod ess;
 mod fft;
 mod normal;
+mod psis;
 
 pub use ess::{ess_bulk, ess_mean, ess_tail, mcse_mean, mcse_sd};
 pub use fft::autocovariance;
 pub use normal::inverse_normal_cdf;
+pub use psis::{KHAT_GOOD, KHAT_UNRELIABLE, Psis, psis, psis_with_reff};
 
 use serde::Serialize;
 

@@ -14,6 +14,7 @@ use crate::error::Error;
 use crate::optimize::{MapSettings, find_map};
 use crate::pipeline::{RunOutput, RunSettings, finish_run, run_sampler};
 use crate::sampler::driver::chain_rng;
+use crate::sampler::proposal::LaplaceProposal;
 use crate::sampler::{ChainOutput, DrawRecord, PhaseCost};
 use crate::study::{Predictive, Problem, posterior_predictive};
 
@@ -116,23 +117,20 @@ pub fn sample(
     Ok(SampledFit { posterior, run })
 }
 
-/// x = MAP + L⁻ᵀ z with z ~ N(0, I) and L Lᵀ the Hessian at the MAP, as one "chain" of
-/// independent draws, so that every summary and figure downstream reads it like a sampled run.
+/// x = MAP + L⁻ᵀ z with z ~ N(0, I) and L Lᵀ the Hessian at the MAP (the Gaussian form of
+/// the samplers' [`LaplaceProposal`]), as one "chain" of independent draws, so that every
+/// summary and figure downstream reads it like a sampled run.
 fn laplace_run(posterior: &mut CalibrationPosterior, seed: u64) -> Result<RunOutput, Error> {
-    use rand_distr::{Distribution, StandardNormal};
     let started = std::time::Instant::now();
     let start = posterior.initial_point()?;
     let map = find_map(posterior, &start, &MapSettings::ranking())?;
-    let (l_inv_t, _) = map.whitening().map_err(Error::Numerical)?;
+    let proposal = LaplaceProposal::new(&map.x, &map.hessian).map_err(Error::Numerical)?;
     let mut rng = chain_rng(seed ^ 0x1a91_ace0, 0);
-    let d = map.x.len();
     let names = posterior.output_names();
     let mut draws = Vec::with_capacity(LAPLACE_DRAWS);
     let mut unconstrained = Vec::with_capacity(LAPLACE_DRAWS);
     for _ in 0..LAPLACE_DRAWS {
-        let z: Vec<f64> = (0..d).map(|_| StandardNormal.sample(&mut rng)).collect();
-        let dx = &l_inv_t * nalgebra::DVector::from_column_slice(&z);
-        let x: Vec<f64> = map.x.iter().zip(dx.iter()).map(|(a, b)| a + b).collect();
+        let x = proposal.draw(&mut rng);
         let mut out = Vec::new();
         posterior.constrain(&x, &mut out);
         draws.push(out);

@@ -31,6 +31,9 @@ pub struct SamplerColumns {
     pub n_leapfrog: u64,
     pub divergent: bool,
     pub energy: f64,
+    /// Importance sampling's weight of the draw, written as `weight__` after `energy__` in a
+    /// file made by [`CmdStanWriter::create_weighted`] (ignored otherwise).
+    pub weight: Option<f64>,
 }
 
 /// Streams one chain's draws to a CmdStan CSV file; the file appears only on
@@ -38,6 +41,7 @@ pub struct SamplerColumns {
 pub struct CmdStanWriter {
     file: AtomicFile,
     n_params: usize,
+    weighted: bool,
     line: String,
 }
 
@@ -48,6 +52,17 @@ impl CmdStanWriter {
         path: &Path,
         metadata: &[(String, String)],
         param_names: &[String],
+    ) -> io::Result<Self> {
+        Self::create_weighted(path, metadata, param_names, false)
+    }
+
+    /// As [`create`](Self::create), with a `weight__` column after CmdStan's sampler columns
+    /// when `weighted` (importance sampling's draws; readers skip it as a sampler column).
+    pub fn create_weighted(
+        path: &Path,
+        metadata: &[(String, String)],
+        param_names: &[String],
+        weighted: bool,
     ) -> io::Result<Self> {
         let invalid =
             |message: String| with_path(path, io::Error::new(io::ErrorKind::InvalidInput, message));
@@ -76,6 +91,9 @@ impl CmdStanWriter {
             head.push_str(&format!("# {} = {}\n", one_line(key), one_line(value)));
         }
         head.push_str(&SAMPLER_COLUMNS.join(","));
+        if weighted {
+            head.push_str(",weight__");
+        }
         for name in param_names {
             head.push(',');
             head.push_str(name);
@@ -87,6 +105,7 @@ impl CmdStanWriter {
         Ok(Self {
             file,
             n_params: param_names.len(),
+            weighted,
             line: String::new(),
         })
     }
@@ -120,6 +139,10 @@ impl CmdStanWriter {
             u8::from(sampler.divergent)
         ));
         table::push_number(line, sampler.energy);
+        if self.weighted {
+            line.push(',');
+            table::push_number(line, sampler.weight.unwrap_or(f64::NAN));
+        }
         for &p in params {
             line.push(',');
             table::push_number(line, p);

@@ -99,6 +99,13 @@ pub struct BenchRecord {
     /// samplers and in files written before it was recorded).
     #[serde(default)]
     pub metric_adaptation: String,
+    /// laplace-is: the Pareto shape k̂ of its importance weights (null for the MCMC samplers
+    /// and in files written before it was recorded).
+    #[serde(default)]
+    pub khat: Option<f64>,
+    /// laplace-is: k̂ > 0.7 and NUTS drew instead; the cost is the whole of both.
+    #[serde(default)]
+    pub fell_back: bool,
 }
 
 fn first_attempt(sampler: SamplerKind, options: &BenchOptions) -> ChainSettings {
@@ -176,9 +183,11 @@ pub fn record(
         converged: ok,
         lower_bound: !ok,
         divergences: run.divergences,
-        cost: RunCost::of(run, sampler.uses_gradient()),
+        cost: RunCost::of(run, sampler.uses_gradient() || run.fell_back),
         prior: CoefficientPrior::default().label(),
         metric_adaptation: String::new(),
+        khat: run.khat,
+        fell_back: run.fell_back,
     }
 }
 

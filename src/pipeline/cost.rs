@@ -5,6 +5,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::RunOutput;
+use crate::density::SolveCount;
 use crate::sampler::clock::Elapsed;
 
 /// The cost of one run and min bulk-ESS per unit of it. Seconds are wall time or CPU time of
@@ -42,6 +43,11 @@ pub struct RunCost {
     /// min bulk-ESS per evaluation of the sampling phase, and per one of all of them.
     pub min_ess_per_eval: f64,
     pub min_ess_per_all_evals: f64,
+    /// Every ODE solve of the run (MAP, initial points, warm-up, sampling): plain f64 solves,
+    /// dual-number solves and the derivative directions those carried.
+    pub solves: SolveCount,
+    /// min bulk-ESS per solve-equivalent of the whole cost ([`SolveCount::equivalents`]).
+    pub min_ess_per_solve: f64,
 }
 
 impl RunCost {
@@ -71,6 +77,7 @@ impl RunCost {
         };
         let total_cpu_s = map.cpu_seconds + warmup.cpu_seconds + sampling.cpu_seconds;
         let ess = run.min_ess_bulk;
+        let solves = map.solves + warmup.solves + sampling.solves;
         Self {
             wall_s: run.wall_seconds,
             map: map.time(),
@@ -85,6 +92,8 @@ impl RunCost {
             min_ess_per_wall_s: ess / run.wall_seconds,
             min_ess_per_eval: ess / evaluations.max(1) as f64,
             min_ess_per_all_evals: ess / all_evaluations.max(1) as f64,
+            solves,
+            min_ess_per_solve: ess / solves.equivalents().max(1) as f64,
         }
     }
 }
@@ -114,6 +123,11 @@ struct CostRecord {
     min_ess_per_wall_s: f64,
     min_ess_per_eval: f64,
     min_ess_per_all_evals: f64,
+    plain_solves: u64,
+    dual_solves: u64,
+    solve_directions: u64,
+    solve_equivalents: u64,
+    min_ess_per_solve: f64,
 }
 
 impl From<RunCost> for CostRecord {
@@ -135,6 +149,11 @@ impl From<RunCost> for CostRecord {
             min_ess_per_wall_s: c.min_ess_per_wall_s,
             min_ess_per_eval: c.min_ess_per_eval,
             min_ess_per_all_evals: c.min_ess_per_all_evals,
+            plain_solves: c.solves.plain,
+            dual_solves: c.solves.dual,
+            solve_directions: c.solves.directions,
+            solve_equivalents: c.solves.equivalents(),
+            min_ess_per_solve: c.min_ess_per_solve,
         }
     }
 }
@@ -159,6 +178,12 @@ impl From<CostRecord> for RunCost {
             min_ess_per_wall_s: r.min_ess_per_wall_s,
             min_ess_per_eval: r.min_ess_per_eval,
             min_ess_per_all_evals: r.min_ess_per_all_evals,
+            solves: SolveCount {
+                plain: r.plain_solves,
+                dual: r.dual_solves,
+                directions: r.solve_directions,
+            },
+            min_ess_per_solve: r.min_ess_per_solve,
         }
     }
 }
@@ -201,6 +226,7 @@ pub(crate) mod tests {
                 density_evaluations: 40,
                 gradient_evaluations: 60,
                 metric_evaluations: 10,
+                ..PhaseCost::default()
             },
             warmup: PhaseCost {
                 wall_seconds: 1.2,
@@ -208,6 +234,7 @@ pub(crate) mod tests {
                 density_evaluations: 4 * 500,
                 gradient_evaluations: 4 * 700,
                 metric_evaluations: 4 * 300,
+                ..PhaseCost::default()
             },
             sampling: PhaseCost {
                 wall_seconds: 9.0,
@@ -215,10 +242,13 @@ pub(crate) mod tests {
                 density_evaluations: 4 * 3000,
                 gradient_evaluations: 4 * 2000,
                 metric_evaluations: 4 * 1000,
+                ..PhaseCost::default()
             },
             divergences: 0,
             map_log_density: 0.0,
             log_evidence_laplace: 0.0,
+            khat: None,
+            fell_back: false,
         }
     }
 
@@ -251,6 +281,24 @@ pub(crate) mod tests {
     }
 
     #[test]
+    fn solves_are_counted_over_the_whole_cost_a_dual_solve_with_its_directions() {
+        let mut r = run(600.0);
+        r.map.solves = SolveCount {
+            plain: 10,
+            dual: 20,
+            directions: 20,
+        };
+        r.sampling.solves = SolveCount {
+            plain: 500,
+            dual: 0,
+            directions: 0,
+        };
+        let cost = RunCost::of(&r, false);
+        assert_eq!(cost.solves.equivalents(), 10 + 20 * 2 + 500);
+        assert_eq!(cost.min_ess_per_solve, 600.0 / 550.0);
+    }
+
+    #[test]
     fn the_cost_is_written_flat_with_the_keys_it_always_had() {
         let cost = RunCost::of(&run(850.0), true);
         let text = serde_json::to_string(&cost).unwrap();
@@ -278,6 +326,12 @@ pub(crate) mod tests {
                 "min_ess_per_wall_s",
                 "min_ess_per_eval",
                 "min_ess_per_all_evals",
+                // Added with the solve count; older files read them as zero.
+                "plain_solves",
+                "dual_solves",
+                "solve_directions",
+                "solve_equivalents",
+                "min_ess_per_solve",
             ]
         );
         assert!(text.contains(r#""map_cpu_s":0.5,"#), "{text}");

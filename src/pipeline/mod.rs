@@ -25,18 +25,22 @@ use crate::sampler::clock::Stopwatch;
 use crate::sampler::driver::chain_rng;
 use crate::sampler::fisher_mala::{FisherMala, FisherMalaAdaptation};
 use crate::sampler::hmc::{Hmc, HmcSettings};
+use crate::sampler::independence::{Independence, IndependenceTuning};
 use crate::sampler::mala::{Mala, MalaAdaptation};
 use crate::sampler::metric::{Metric, MetricKind};
 use crate::sampler::metropolis::{Metropolis, PyMc3Tuning};
 use crate::sampler::nuts::{Nuts, NutsSettings};
+use crate::sampler::proposal::LaplaceProposal;
 use crate::sampler::{Adaptation, ChainOutput, Kernel, RunControl, run_chains_until};
 
 use crate::error::{Error, InputError};
 
 pub mod cost;
+mod importance;
 pub mod settings;
 pub use crate::sampler::PhaseCost;
 pub use cost::{RunCost, ratio_2sf};
+pub use importance::IS_SHAPE;
 pub use settings::{
     LAPLACE_TARGET_ACCEPT, LAPLACE_WARMUP, MetricAdaptation, RunSettings, SamplerKind,
     default_warmup,
@@ -69,6 +73,10 @@ pub struct RunOutput {
     pub divergences: usize,
     pub map_log_density: f64,
     pub log_evidence_laplace: f64,
+    /// laplace-is: the Pareto shape k̂ of its importance weights (`None` for the MCMC samplers).
+    pub khat: Option<f64>,
+    /// laplace-is: k̂ said the Laplace approximation cannot be trusted and NUTS drew instead.
+    pub fell_back: bool,
 }
 
 impl RunOutput {
@@ -223,6 +231,8 @@ pub fn finish_run(
         divergences: chains.iter().map(|c| c.divergences).sum(),
         map_log_density: map.log_density,
         log_evidence_laplace: map.log_evidence_laplace,
+        khat: None,
+        fell_back: false,
         summaries,
         chains,
     }
@@ -250,6 +260,9 @@ pub fn run_sampler<P: Fittable>(
     )?;
     let map_cost = PhaseCost::counted(map_watch.elapsed(), &counted);
     let label = format!("{label} {}", settings.sampler.name());
+    if settings.sampler == SamplerKind::LaplaceIs {
+        return importance::laplace_is(posterior, &map, map_cost, settings, &label, started);
+    }
     let chains = dispatch(posterior, &map, &inits, settings, &label)?;
     Ok(RunOutput {
         map: map_cost,
@@ -287,6 +300,17 @@ fn dispatch<P: Fittable>(
                 MalaAdaptation::step_size_only(),
             ))
         })?)),
+        SamplerKind::Independence => {
+            Ok(outputs(execute(posterior, inits, settings, label, |_| {
+                let proposal = LaplaceProposal::new(&map.x, &map.hessian).map_err(fatal)?;
+                let mut kernel = Independence::new(proposal);
+                IndependenceTuning::start(&mut kernel);
+                Ok((kernel, IndependenceTuning::default()))
+            })?))
+        }
+        SamplerKind::LaplaceIs => Err(Error::invalid(
+            "importance sampling runs no chains: run_sampler sends it to its own path",
+        )),
         SamplerKind::FisherMala => Ok(outputs(execute(posterior, inits, settings, label, |_| {
             let step = 1.65 * (map.x.len() as f64).powf(-1.0 / 3.0);
             Ok((
@@ -467,7 +491,8 @@ pub fn write_draws(
         let mut meta = metadata.to_vec();
         meta.push(("sampler".into(), run.sampler.clone()));
         meta.push(("chain".into(), (chain.chain + 1).to_string()));
-        let mut writer = CmdStanWriter::create(&path, &meta, &chain.names)?;
+        let weighted = chain.records.iter().any(|r| r.weight.is_some());
+        let mut writer = CmdStanWriter::create_weighted(&path, &meta, &chain.names, weighted)?;
         for (draw, record) in chain.draws.iter().zip(&chain.records) {
             let columns = SamplerColumns {
                 lp: record.lp,
@@ -477,6 +502,7 @@ pub fn write_draws(
                 n_leapfrog: record.n_steps as u64,
                 divergent: record.divergent,
                 energy: record.energy,
+                weight: record.weight,
             };
             writer.write_draw(&columns, draw)?;
         }

@@ -30,6 +30,12 @@ pub enum SamplerKind {
     NutsDense,
     /// Simplified manifold MALA with the Gauss–Newton (Fisher) metric.
     FisherMala,
+    /// Independence Metropolis–Hastings from a Student-t at the MAP with the Laplace
+    /// covariance; no gradients.
+    Independence,
+    /// Importance sampling from the same Student-t, Pareto-smoothed, resampled to equal
+    /// weights; falls back to NUTS when k̂ > 0.7.
+    LaplaceIs,
 }
 
 impl SamplerKind {
@@ -43,13 +49,18 @@ impl SamplerKind {
             SamplerKind::NutsDiag => "nuts-diag",
             SamplerKind::NutsDense => "nuts-dense",
             SamplerKind::FisherMala => "fisher-mala",
+            SamplerKind::Independence => "independence",
+            SamplerKind::LaplaceIs => "laplace-is",
         }
     }
 
     pub fn uses_gradient(&self) -> bool {
         !matches!(
             self,
-            SamplerKind::Metropolis | SamplerKind::AdaptiveMetropolis
+            SamplerKind::Metropolis
+                | SamplerKind::AdaptiveMetropolis
+                | SamplerKind::Independence
+                | SamplerKind::LaplaceIs
         )
     }
 
@@ -64,7 +75,7 @@ impl SamplerKind {
         )
     }
 
-    pub const ALL: [SamplerKind; 8] = [
+    pub const ALL: [SamplerKind; 10] = [
         SamplerKind::Metropolis,
         SamplerKind::AdaptiveMetropolis,
         SamplerKind::Mala,
@@ -73,6 +84,8 @@ impl SamplerKind {
         SamplerKind::NutsDiag,
         SamplerKind::NutsDense,
         SamplerKind::FisherMala,
+        SamplerKind::Independence,
+        SamplerKind::LaplaceIs,
     ];
 }
 
@@ -107,12 +120,14 @@ pub enum MetricAdaptation {
 /// in the 21 runs, from 20 on 1–3 (papers/john2018, "The warm-up"). 100 leaves dual averaging
 /// (t₀ = 10) ten times its damping span to settle, for posteriors less Gaussian than the
 /// paper's, at a tenth of 1000 draws. Everything else keeps Stan's 1000: the windows need it
-/// to estimate a metric, and MALA's step-size search is noisier.
+/// to estimate a metric, and MALA's step-size search is noisier. The independence sampler
+/// tries each of its proposal shapes for 40 transitions; importance sampling has no warm-up.
 pub fn default_warmup(sampler: SamplerKind, metric: MetricAdaptation) -> usize {
-    if sampler.is_hamiltonian() && metric == MetricAdaptation::Laplace {
-        LAPLACE_WARMUP
-    } else {
-        1000
+    match sampler {
+        SamplerKind::Independence => crate::sampler::independence::INDEPENDENCE_WARMUP,
+        SamplerKind::LaplaceIs => 0,
+        _ if sampler.is_hamiltonian() && metric == MetricAdaptation::Laplace => LAPLACE_WARMUP,
+        _ => 1000,
     }
 }
 
@@ -174,6 +189,9 @@ pub struct RunSettings {
     /// Keep every warm-up draw in the chains' output too (the draws are the same either way).
     #[serde(skip)]
     pub save_warmup: bool,
+    /// laplace-is: run NUTS (dense) on the same problem instead when k̂ says the Laplace
+    /// approximation cannot be trusted.
+    pub fallback: bool,
 }
 
 impl Default for RunSettings {
@@ -191,6 +209,7 @@ impl Default for RunSettings {
             metric_adaptation: MetricAdaptation::default(),
             stop: None,
             save_warmup: false,
+            fallback: true,
         }
     }
 }

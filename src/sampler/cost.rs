@@ -8,7 +8,7 @@ use std::ops::Add;
 use serde::Serialize;
 
 use super::clock::Elapsed;
-use crate::density::Counted;
+use crate::density::{Counted, LogDensity, SolveCount};
 
 /// A phase's wall time, the CPU time of the thread that ran it, and its evaluations.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
@@ -20,17 +20,21 @@ pub struct PhaseCost {
     /// Fisher metrics (or observed informations) evaluated: Fisher-MALA evaluates one per
     /// proposal, the MAP one for its Hessian.
     pub metric_evaluations: u64,
+    /// The ODE solves behind those evaluations (fewer than evaluations where the density's
+    /// cache served one).
+    pub solves: SolveCount,
 }
 
 impl PhaseCost {
     /// A phase that took `time`, with every evaluation `density` has counted so far.
-    pub fn counted<P>(time: Elapsed, density: &Counted<P>) -> Self {
+    pub fn counted<P: LogDensity>(time: Elapsed, density: &Counted<P>) -> Self {
         Self {
             wall_seconds: time.wall_seconds,
             cpu_seconds: time.cpu_seconds,
             density_evaluations: density.density_evaluations,
             gradient_evaluations: density.gradient_evaluations,
             metric_evaluations: density.metric_evaluations,
+            solves: density.solves(),
         }
     }
 
@@ -41,6 +45,7 @@ impl PhaseCost {
             density_evaluations: self.density_evaluations - earlier.density_evaluations,
             gradient_evaluations: self.gradient_evaluations - earlier.gradient_evaluations,
             metric_evaluations: self.metric_evaluations - earlier.metric_evaluations,
+            solves: self.solves - earlier.solves,
             ..self
         }
     }
@@ -66,6 +71,7 @@ impl Add for PhaseCost {
             density_evaluations: self.density_evaluations + other.density_evaluations,
             gradient_evaluations: self.gradient_evaluations + other.gradient_evaluations,
             metric_evaluations: self.metric_evaluations + other.metric_evaluations,
+            solves: self.solves + other.solves,
         }
     }
 }
@@ -82,7 +88,7 @@ mod tests {
 
     #[test]
     fn a_later_phase_counts_only_its_own_evaluations() {
-        let mut density = Counted::new(());
+        let mut density = Counted::new(crate::sampler::targets::Gaussian::correlated(2, 0.0, 1.0));
         density.gradient_evaluations = 7;
         density.metric_evaluations = 2;
         let time = |s| Elapsed {
@@ -101,6 +107,7 @@ mod tests {
                 density_evaluations: 3,
                 gradient_evaluations: 3,
                 metric_evaluations: 0,
+                solves: SolveCount::default(),
             }
         );
         let both: PhaseCost = [warmup, sampling].into_iter().sum();

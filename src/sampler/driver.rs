@@ -65,6 +65,9 @@ pub struct DrawRecord {
     pub n_steps: u32,
     pub divergent: bool,
     pub energy: f64,
+    /// Importance sampling's normalised (smoothed) weight of the proposal this draw copies;
+    /// `None` for the Markov chains, whose draws all weigh the same.
+    pub weight: Option<f64>,
 }
 
 impl DrawRecord {
@@ -78,6 +81,7 @@ impl DrawRecord {
             n_steps: info.n_steps,
             divergent: info.divergent,
             energy: info.energy,
+            weight: None,
         }
     }
 }

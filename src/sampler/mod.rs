@@ -13,11 +13,14 @@ pub mod driver;
 pub mod fisher_mala;
 pub mod hamiltonian;
 pub mod hmc;
+pub mod importance;
+pub mod independence;
 pub mod langevin;
 pub mod mala;
 pub mod metric;
 pub mod metropolis;
 pub mod nuts;
+pub mod proposal;
 pub mod targets;
 pub mod welford;
 

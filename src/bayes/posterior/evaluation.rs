@@ -7,7 +7,7 @@ use std::ops::Range;
 use nalgebra::DMatrix;
 
 use super::{CalibrationPosterior, ChannelTerm, LN_2PI, PriorInU, RecordTerm, column_rows};
-use crate::density::{DensityError, FisherMetric, LogDensity, StartingPoint};
+use crate::density::{DensityError, FisherMetric, LogDensity, SolveCount, StartingPoint};
 use crate::parameter::{Prior, Transform};
 
 /// One channel of one recording at a point, as a walk over the likelihood sees it.
@@ -158,6 +158,13 @@ impl LogDensity for CalibrationPosterior {
 
     fn output_names(&self) -> Vec<String> {
         self.output_names.clone()
+    }
+
+    fn solves(&self) -> SolveCount {
+        self.records
+            .iter()
+            .map(|r| r.solves.0)
+            .fold(SolveCount::default(), |a, b| a + b)
     }
 
     fn constrain(&self, x: &[f64], out: &mut Vec<f64>) {
