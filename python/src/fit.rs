@@ -12,6 +12,7 @@ use motorcal::pipeline::{
     posterior_mean, run_sampler, write_draws,
 };
 use motorcal::sampler::{ChainSettings, DrawRecord};
+use motorcal::study::replicated_recordings;
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -127,7 +128,7 @@ fn cube<'py>(
 /// Runs the fit; returns a dict of NumPy arrays and the fit's figures (see
 /// `motorcal.fit`).
 #[pyfunction]
-#[pyo3(signature = (recordings, model, bm=None, k=None, sampler="nuts-dense", chains=4, warmup=None, draws=1000, keep=None, seed=motorcal::synthetic::DEFAULT_SEED, threads=None, metric_adaptation=None, prior_family="laplace", prior_decay=0.0, force=false, out=None, save_warmup=true))]
+#[pyo3(signature = (recordings, model, bm=None, k=None, sampler="nuts-dense", chains=4, warmup=None, draws=1000, keep=None, seed=motorcal::synthetic::DEFAULT_SEED, threads=None, metric_adaptation=None, prior_family="laplace", prior_decay=0.0, force=false, out=None, save_warmup=true, posterior_predictive=true))]
 #[allow(clippy::too_many_arguments)]
 pub fn fit_raw<'py>(
     py: Python<'py>,
@@ -148,6 +149,7 @@ pub fn fit_raw<'py>(
     force: bool,
     out: Option<PathBuf>,
     save_warmup: bool,
+    posterior_predictive: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let calibration = Calibration {
         bm,
@@ -168,12 +170,44 @@ pub fn fit_raw<'py>(
     )
     .map_err(py_error)?;
     settings.save_warmup = save_warmup;
-    let fitted = interruptible(py, |stop| {
+    let (fitted, replicated) = interruptible(py, |stop| {
         settings.stop = Some(stop);
-        fit_work(&recordings, &model, &calibration, &settings, out.as_ref())
+        let fitted = fit_work(&recordings, &model, &calibration, &settings, out.as_ref())?;
+        // Replicated recordings from the kept draws, while the GIL is still released.
+        let replicated = if posterior_predictive {
+            let mut posterior = fitted.posterior.inner.clone();
+            Some(replicated_recordings(
+                &mut posterior,
+                &fitted.run.chains,
+                seed,
+            )?)
+        } else {
+            None
+        };
+        Ok::<_, Error>((fitted, replicated))
     })?
     .map_err(py_error)?;
-    report(py, &fitted)
+    let dict = report(py, &fitted)?;
+    if let Some(replicated) = replicated {
+        let posterior = &fitted.posterior.inner;
+        let predictive = PyDict::new(py);
+        let several = posterior.n_records() > 1;
+        for (r, per_record) in replicated.iter().enumerate() {
+            let suffix = if several {
+                format!("_r{}", r + 1)
+            } else {
+                String::new()
+            };
+            for (name, per_channel) in posterior.channel_names(r).into_iter().zip(per_record) {
+                let shape = (per_channel.len(), per_channel.first().map_or(0, Vec::len));
+                let n = posterior.observed(r, 0).len();
+                let cube = cube(py, shape, n, |c, s| per_channel[c][s].clone())?;
+                predictive.set_item(format!("{name}{suffix}"), cube)?;
+            }
+        }
+        dict.set_item("posterior_predictive", predictive)?;
+    }
+    Ok(dict)
 }
 
 fn report<'py>(py: Python<'py>, f: &Fitted) -> PyResult<Bound<'py, PyDict>> {

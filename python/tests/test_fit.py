@@ -116,3 +116,18 @@ def test_the_warmup_groups_hold_every_warmup_draw(py_fit):
     # Dual averaging moves the step size in warm-up; sampling keeps the one it settled on.
     assert len(np.unique(step[0])) > 1
     assert len(np.unique(py_fit.sample_stats.step_size.values[0])) == 1
+
+
+def test_the_posterior_predictive_scatters_about_the_fit_by_its_noise(py_fit):
+    """Each kept draw replicates the recording: named and shaped like the observed data, and
+    across draws it spreads about the fit by the fitted noise σ (plus the little that θ and δ
+    vary), not by nothing and not by more."""
+    predictive = py_fit.posterior_predictive
+    assert set(predictive.data_vars) == set(py_fit.observed_data.data_vars)
+    for name in predictive.data_vars:
+        values = predictive[name].values
+        n = py_fit.observed_data[name].values.shape[0]
+        assert values.shape == (OPTIONS["chains"], OPTIONS["draws"], n)
+        sigma = py_fit.posterior[f"sigma_{name}"].values.mean()
+        spread = values.reshape(-1, n).std(axis=0).mean()
+        assert 0.9 * sigma < spread < 1.2 * sigma, (name, spread, sigma)

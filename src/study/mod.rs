@@ -13,5 +13,5 @@ mod problem;
 
 pub use inputs::InputProfile;
 pub use predict::{ChannelResidual, RecordPrediction, predict_records, residuals};
-pub use predictive::{ChannelPredictive, Predictive, posterior_predictive};
+pub use predictive::{ChannelPredictive, Predictive, posterior_predictive, replicated_recordings};
 pub use problem::{BOUNDED_STARTS, Problem, Reference, recording_from};

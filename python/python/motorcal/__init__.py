@@ -107,6 +107,7 @@ def fit(
     force=False,
     out=None,
     save_warmup=True,
+    posterior_predictive=True,
     inference_data=None,
 ):
     """Calibrate ``model`` on ``recordings`` (one or a list) as ``motorcal fit`` does: the MAP
@@ -116,6 +117,10 @@ def fit(
     to the sampler's (100 for HMC/NUTS on the Laplace metric, else 1000). With ``out`` the
     draws are also written there as CmdStan CSV (``fit-<sampler>-chain<N>.csv``), after the run:
     an interrupted fit writes nothing.
+
+    With ``posterior_predictive`` every kept draw also gives a replicated recording,
+    G(θ) + δ + σ·ε (one solve a draw, the noise from ``seed``): the ``posterior_predictive``
+    group, named like ``observed_data``.
 
     Returns ``arviz.InferenceData`` (posterior, sample_stats, observed_data and the
     ``unconstrained_posterior`` group of the sampler's coordinates, and with ``save_warmup``
@@ -143,6 +148,7 @@ def fit(
         force=force,
         out=None if out is None else str(out),
         save_warmup=save_warmup,
+        posterior_predictive=posterior_predictive,
     )
     names = raw["names"]
     posterior = {name: raw["draws"][:, :, j] for j, name in enumerate(names)}
@@ -171,6 +177,8 @@ def fit(
         observed_data=raw["observed_data"],
         unconstrained=unconstrained,
     )
+    if "posterior_predictive" in raw:
+        result["posterior_predictive"] = raw["posterior_predictive"]
     if warmup is not None:
         result["warmup_posterior"] = warmup["posterior"]
         result["warmup_sample_stats"] = warmup["sample_stats"]
@@ -207,6 +215,8 @@ def _inference_data(arviz, posterior, unconstrained, stats, warmup, raw, figures
             "warmup_sample_stats": _arviz_names(warmup["sample_stats"]),
             "save_warmup": True,
         }
+    if "posterior_predictive" in raw:
+        extra["posterior_predictive"] = raw["posterior_predictive"]
     idata = arviz.from_dict(
         posterior=posterior,
         sample_stats=_arviz_names(stats),
