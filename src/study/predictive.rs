@@ -123,18 +123,21 @@ pub fn posterior_predictive(
     Ok(Predictive { times, channels })
 }
 
+/// A channel's replicated recordings: `[chain][draw][sample]`.
+pub type Replicated = Vec<Vec<Vec<f64>>>;
+
 /// Replicated recordings, one per kept draw: y_rep = G(θ) + δ(a) + σ·ε, ε ~ N(0, 1) — what
-/// ArviZ calls the posterior predictive. Indexed `[record][channel][chain][draw][sample]`. The
+/// ArviZ calls the posterior predictive, per record and channel. The
 /// noise comes from `seed`'s own stream per chain, so the same draws and seed replicate alike
 /// whatever the thread count. One plain solve per draw.
 pub fn replicated_recordings(
     posterior: &mut CalibrationPosterior,
     chains: &[ChainOutput],
     seed: u64,
-) -> Result<Vec<Vec<Vec<Vec<Vec<f64>>>>>, Error> {
+) -> Result<Vec<Vec<Replicated>>, Error> {
     use rand_distr::{Distribution, StandardNormal};
     let records = posterior.n_records();
-    let mut out: Vec<Vec<Vec<Vec<Vec<f64>>>>> = (0..records)
+    let mut out: Vec<Vec<Replicated>> = (0..records)
         .map(|r| vec![Vec::with_capacity(chains.len()); posterior.channel_names(r).len()])
         .collect();
     for (c, chain) in chains.iter().enumerate() {
