@@ -40,8 +40,8 @@ pub struct DesignArgs {
     #[arg(long)]
     pub rate: f64,
     /// The drive's limits, e.g. U=±24,I=±300,omega=±3000.
-    #[arg(long, value_parser = parse_limits, allow_hyphen_values = true)]
-    pub limits: Limits,
+    #[arg(long, allow_hyphen_values = true)]
+    pub limits: String,
     /// Voltage segments of the designed input.
     #[arg(long, default_value_t = 8)]
     pub segments: usize,
@@ -61,13 +61,13 @@ pub struct DesignArgs {
     pub out: PathBuf,
 }
 
-fn parse_limits(text: &str) -> Result<Limits, String> {
-    text.parse()
-}
-
 /// `motorcal design`: search, write, say what it wrote.
 pub fn run(args: &DesignArgs) -> Result<(), AppError> {
     let started = Instant::now();
+    let limits: Limits = args
+        .limits
+        .parse()
+        .map_err(|e| AppError::Usage(format!("--limits {}: {e}", args.limits)))?;
     let model = read_model_file(&args.model)?;
     let times = design_times(args.duration, args.rate)?;
     let base = design_problem(&model, &times)?;
@@ -80,7 +80,7 @@ pub fn run(args: &DesignArgs) -> Result<(), AppError> {
             seed: args.seed,
             ..SearchSettings::default()
         },
-        limits: args.limits,
+        limits,
         draws: args.draws.max(2),
     };
     if args.segments == 0 {
@@ -176,7 +176,7 @@ pub fn run(args: &DesignArgs) -> Result<(), AppError> {
         (report, d.values, figure)
     };
     let mut report = report;
-    report["limits"] = json!(args.limits);
+    report["limits"] = json!(limits);
     report["seed"] = json!(args.seed);
     report["duration_s"] = json!(args.duration);
     report["rate_hz"] = json!(args.rate);

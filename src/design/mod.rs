@@ -249,11 +249,12 @@ pub fn separate(
     }
     check_possible(experiment, &settings.limits)?;
     let search_limits = tightened(&settings.limits);
-    let cost = |input: &VoltageInput| match noise_free_leads(experiment, input, &search_limits) {
-        Ok(Evaluation::Infeasible { excess }) => INFEASIBLE * (1.0 + excess),
-        Ok(e) => -e.worst(),
-        Err(_) => INFEASIBLE * 1e3,
-    };
+    let cost =
+        |input: &VoltageInput| match noise_free_leads(experiment, input, &search_limits, false) {
+            Ok(Evaluation::Infeasible { excess }) => INFEASIBLE * (1.0 + excess),
+            Ok(e) => -e.worst(),
+            Err(_) => INFEASIBLE * 1e3,
+        };
     let (profile, values, input, check) = search_profile(experiment, settings, cost)?;
     let seed = settings.search.seed;
     let gaps = expected_gaps(experiment, &input, &settings.limits, settings.draws, seed)?;

@@ -74,12 +74,17 @@ pub fn predictions(
     Ok((out, excess))
 }
 
+/// Gauss–Newton steps the search's rival fits take ([`noise_free_leads`] without polish).
+pub const SEARCH_STEPS: usize = 3;
+
 /// The search's objective: every truth's noise-free lead over its best-fitting rival, each
-/// rival fitted from its own estimate.
+/// rival fitted from its own estimate — by [`SEARCH_STEPS`] safeguarded Gauss–Newton steps in
+/// the search, to convergence (Levenberg–Marquardt) with `polish` for what is reported.
 pub fn noise_free_leads(
     experiment: &Experiment,
     input: &VoltageInput,
     limits: &Limits,
+    polish: bool,
 ) -> Result<Evaluation, Error> {
     let (truths, excess) = predictions(experiment, input, limits)?;
     if excess > 0.0 {
@@ -104,8 +109,11 @@ pub fn noise_free_leads(
             }
             let forward = rival.forward(input, &experiment.times)?;
             let specs = forward.calibrated_specs();
-            let (ss, theta) =
-                levenberg_marquardt(&forward, &specs, &truths[a], &weights, rival.theta.clone())?;
+            let (ss, theta) = if polish {
+                levenberg_marquardt(&forward, &specs, &truths[a], &weights, rival.theta.clone())?
+            } else {
+                gauss_newton(&forward, &specs, &truths[a], &weights, rival.theta.clone())?
+            };
             let d = rival.theta.len() as f64 - truth.theta.len() as f64;
             let gap = 0.5 * ss + 0.5 * d * ln_n;
             if gap < best.gap {
@@ -147,7 +155,8 @@ pub fn expected_gaps(
     draws: usize,
     seed: u64,
 ) -> Result<Vec<ExpectedGap>, Error> {
-    let Evaluation::Feasible { leads, fits } = noise_free_leads(experiment, input, limits)? else {
+    let Evaluation::Feasible { leads, fits } = noise_free_leads(experiment, input, limits, true)?
+    else {
         return Err(Error::invalid("the input passes the limits"));
     };
     let weights = experiment.weights();
@@ -268,7 +277,7 @@ pub fn lead_curves(experiment: &Experiment, input: &VoltageInput) -> Result<Lead
         current: f64::INFINITY,
         speed: f64::INFINITY,
     };
-    let evaluation = noise_free_leads(experiment, input, &open)?;
+    let evaluation = noise_free_leads(experiment, input, &open, true)?;
     let Evaluation::Feasible { leads, fits } = evaluation else {
         return Err(Error::invalid("no limits to pass"));
     };
@@ -294,4 +303,77 @@ pub fn lead_curves(experiment: &Experiment, input: &VoltageInput) -> Result<Lead
         truth,
         rival_fit,
     })
+}
+
+/// A few Gauss–Newton steps on the weighted residual, each kept only if it lowers the sum of
+/// squares (projected into the supports): the search's cheap rival fit.
+fn gauss_newton(
+    forward: &crate::forward::ForwardModel,
+    specs: &[ParameterSpec],
+    target: &[f64],
+    weights: &[f64],
+    mut theta: Vec<f64>,
+) -> Result<(f64, Vec<f64>), Error> {
+    let n = forward.n_outputs();
+    let d = theta.len();
+    let mut out = vec![0.0; n];
+    let mut jac = DMatrix::zeros(n, d);
+    let ss_of = |out: &[f64]| -> f64 {
+        out.iter()
+            .zip(target)
+            .zip(weights)
+            .map(|((g, y), w)| ((y - g) * w).powi(2))
+            .sum()
+    };
+    forward
+        .simulate_with_sensitivities(&theta, &mut out, &mut jac)
+        .map_err(numerical)?;
+    let mut ss = ss_of(&out);
+    for step in 0..SEARCH_STEPS {
+        for (r, w) in weights.iter().enumerate() {
+            for c in 0..d {
+                jac[(r, c)] *= w;
+            }
+        }
+        let r = DVector::from_iterator(n, (0..n).map(|i| (target[i] - out[i]) * weights[i]));
+        let jtj = jac.transpose() * &jac;
+        let jtr = jac.transpose() * r;
+        let mut a = jtj.clone();
+        for j in 0..d {
+            a[(j, j)] += 1e-9 * jtj[(j, j)].max(1e-300);
+        }
+        let Some(delta) = a.cholesky().map(|c| c.solve(&jtr)) else {
+            break;
+        };
+        let trial: Vec<f64> = theta
+            .iter()
+            .zip(delta.iter())
+            .zip(specs)
+            .map(|((t, s), spec)| match spec.support {
+                Support::Positive => (t + s).max(0.0),
+                Support::Bounded { lower, upper } => (t + s).clamp(lower, upper),
+                Support::Real => t + s,
+            })
+            .collect();
+        let mut trial_out = vec![0.0; n];
+        let last = step + 1 == SEARCH_STEPS;
+        let result = if last {
+            forward.simulate(&trial, &mut trial_out).map(|_| ())
+        } else {
+            forward
+                .simulate_with_sensitivities(&trial, &mut trial_out, &mut jac)
+                .map(|_| ())
+        };
+        if result.is_err() {
+            break;
+        }
+        let trial_ss = ss_of(&trial_out);
+        if !(trial_ss < ss) {
+            break;
+        }
+        theta = trial;
+        ss = trial_ss;
+        out = trial_out;
+    }
+    Ok((ss, theta))
 }
