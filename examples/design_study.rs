@@ -7,7 +7,10 @@
 //! candidates refitted by `diagnose`'s scoring (`fit_candidate`), and how often the truth
 //! scores higher, and higher by more than the 2-nat threshold.
 //!
-//!   cargo run --release --example design_study -- separate DIR a,b [--records 20]
+//! With `--diagnose N`, the first N records of each truth also go through the whole ranking
+//! (`discover` with `rank_only`, every library candidate) and the selected term is counted.
+//!
+//!   cargo run --release --example design_study -- separate DIR a,b [--records 20] [--diagnose N]
 //!
 //! Pinning, on the paper's model (c_g = 0.009, σ = 2 A and 10 rad/s): the design for R and
 //! c_g/J, then `--records` noisy records of the model on the designed and on the constant 24-V
@@ -24,7 +27,7 @@ use motorcal::design::{
     self, Candidate, DesignSettings, Experiment, Limits, SearchSettings, Target, design_problem,
     design_times,
 };
-use motorcal::discover::{EVIDENCE_THRESHOLD, fit_candidate};
+use motorcal::discover::{DiscoverSettings, EVIDENCE_THRESHOLD, discover, fit_candidate};
 use motorcal::io::{ModelFile, read_model_file};
 use motorcal::motor::{MotorParameters, VoltageInput};
 use motorcal::study::Problem;
@@ -34,16 +37,22 @@ const LIMITS: &str = "U=±24,I=±300,omega=±3000";
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let records = args
-        .iter()
-        .position(|a| a == "--records")
-        .and_then(|i| args.get(i + 1))
-        .map(|s| s.parse::<usize>())
-        .transpose()?;
+    let option = |name: &str| {
+        args.iter()
+            .position(|a| a == name)
+            .and_then(|i| args.get(i + 1))
+            .map(|s| s.parse::<usize>())
+            .transpose()
+    };
+    let records = option("--records")?;
+    let diagnosed = option("--diagnose")?.unwrap_or(0);
     match args.first().map(String::as_str) {
-        Some("separate") if args.len() >= 3 => {
-            separate(PathBuf::from(&args[1]), &args[2], records.unwrap_or(20))
-        }
+        Some("separate") if args.len() >= 3 => separate(
+            PathBuf::from(&args[1]),
+            &args[2],
+            records.unwrap_or(20),
+            diagnosed,
+        ),
         Some("pin") => pin(records.unwrap_or(30)),
         _ => Err("usage: design_study separate DIR a,b [--records N] | pin [--records N]".into()),
     }
@@ -80,7 +89,12 @@ fn values(diag: &serde_json::Value, name: &str) -> BTreeMap<String, f64> {
     out
 }
 
-fn separate(dir: PathBuf, pair: &str, records: usize) -> Result<(), Box<dyn std::error::Error>> {
+fn separate(
+    dir: PathBuf,
+    pair: &str,
+    records: usize,
+    diagnosed: usize,
+) -> Result<(), Box<dyn std::error::Error>> {
     let model = read_model_file(&dir.join("motor.toml"))?;
     let diag: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("diag.json"))?)?;
@@ -120,6 +134,7 @@ fn separate(dir: PathBuf, pair: &str, records: usize) -> Result<(), Box<dyn std:
     for (t, truth) in experiment.candidates.iter().enumerate() {
         let motor = truth.problem.model.model(input.clone())?;
         let (mut named, mut clear) = (0, 0);
+        let mut selected = Vec::new();
         for k in 0..records {
             let data = generate(&motor, &times, &[2.0, 10.0], 7000 + k as u64)?;
             let recording =
@@ -141,6 +156,14 @@ fn separate(dir: PathBuf, pair: &str, records: usize) -> Result<(), Box<dyn std:
                 .filter(|(i, _)| *i != t)
                 .map(|(_, s)| scores[t] - s)
                 .fold(f64::INFINITY, f64::min);
+            if k < diagnosed {
+                let mut settings = DiscoverSettings {
+                    rank_only: true,
+                    ..DiscoverSettings::default()
+                };
+                settings.run.quiet = true;
+                selected.push(discover(&problem, &settings)?.selected);
+            }
             named += usize::from(lead > 0.0);
             clear += usize::from(lead > EVIDENCE_THRESHOLD);
         }
@@ -149,6 +172,15 @@ fn separate(dir: PathBuf, pair: &str, records: usize) -> Result<(), Box<dyn std:
              by more than {EVIDENCE_THRESHOLD} nats in {clear}",
             truth.name
         );
+        if diagnosed > 0 {
+            let hits = selected.iter().filter(|s| **s == truth.name).count();
+            println!(
+                "  {} as truth, the first {} records through the whole ranking: selected {hits} \
+                 times ({selected:?})",
+                truth.name,
+                selected.len()
+            );
+        }
     }
     Ok(())
 }

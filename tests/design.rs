@@ -107,7 +107,7 @@ fn designed_inputs_stay_within_the_limits() {
 }
 
 #[test]
-fn the_same_seed_gives_the_same_design() {
+fn the_same_seed_gives_the_same_design_whatever_the_thread_count() {
     let experiment = tied_pair(0.05, 400.0);
     let settings = DesignSettings {
         search: SearchSettings {
@@ -119,8 +119,14 @@ fn the_same_seed_gives_the_same_design() {
         limits: "U=±24,I=±300,omega=±3000".parse().unwrap(),
         draws: 3,
     };
-    let a = design::separate(&experiment, &settings).unwrap();
-    let b = design::separate(&experiment, &settings).unwrap();
+    let on = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| design::separate(&experiment, &settings).unwrap())
+    };
+    let (a, b) = (on(1), on(3));
     assert_eq!(a.values, b.values);
     assert_eq!(a.expected_gap_nats.to_bits(), b.expected_gap_nats.to_bits());
 }
