@@ -13,6 +13,7 @@
 pub mod app;
 pub mod bayes;
 pub mod density;
+pub mod design;
 pub mod diagnostics;
 pub mod discover;
 pub mod error;

@@ -34,6 +34,9 @@ enum Command {
     /// Find the physics the model left out: locate the mismatch, rank candidate terms by
     /// evidence, add the best, refit, and show the fit improve.
     Diagnose(app::diagnose::DiagnoseArgs),
+    /// The input to record next, within the drive's limits: one that tells a diagnosis's tied
+    /// candidates apart (--separate) or pins parameters (--pin).
+    Design(app::design::DesignArgs),
     /// Reproduce a result of the paper.
     Reproduce {
         #[command(subcommand)]
@@ -66,6 +69,7 @@ fn run(cli: Cli) -> Result<(), AppError> {
         Some(Command::Merge(args)) => app::merge::run(&args),
         Some(Command::Diagnose(args)) => app::diagnose::run(&args),
         Some(Command::Predict(args)) => app::predict::run(&args),
+        Some(Command::Design(args)) => app::design::run(&args),
         Some(Command::Summarize(args)) => app::summarize::run(&args),
     }
 }

@@ -7,7 +7,7 @@ use std::collections::BTreeSet;
 use std::path::Path;
 
 /// ARCHITECTURE.md's order, top to bottom.
-const ORDER: [&str; 19] = [
+const ORDER: [&str; 20] = [
     "error",
     "parameter",
     "ode",
@@ -25,6 +25,7 @@ const ORDER: [&str; 19] = [
     "plot",
     "study",
     "discover",
+    "design",
     "paper",
     "app",
 ];

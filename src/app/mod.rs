@@ -7,6 +7,7 @@
 pub mod args;
 pub mod bench;
 pub mod cases;
+pub mod design;
 pub mod diagnose;
 pub mod figures;
 pub mod fit;

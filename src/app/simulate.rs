@@ -3,7 +3,9 @@
 
 use std::path::PathBuf;
 
-use crate::io::{ModelFile, read_model_file, write_model_file, write_recording};
+use crate::io::{
+    ModelFile, read_model_file, read_voltage_profile, write_model_file, write_recording,
+};
 use crate::motor::{MotorParameters, VoltageInput};
 pub use crate::study::InputProfile;
 
@@ -21,6 +23,36 @@ use crate::synthetic::{DEFAULT_SEED, generate, sample_times};
 
 use super::AppError;
 
+/// Samples and length of a record driven by a profile, unless the command line says otherwise.
+pub const DEFAULT_SAMPLES: usize = 501;
+pub const DEFAULT_T_END: f64 = 0.5;
+
+/// What drives the simulated motor: a named profile or a `t,U` file.
+#[derive(Clone, Debug, PartialEq)]
+pub enum InputSource {
+    Profile(InputProfile),
+    File(PathBuf),
+}
+
+impl InputSource {
+    /// A profile's name, or else the path of a file (read, and refused with its error, later).
+    pub fn parse(text: &str) -> Result<Self, String> {
+        if text.is_empty() {
+            return Err(format!(
+                "empty; give a profile ({}) or the path of a t,U file",
+                InputProfile::ALL.map(|p| p.name()).join(", ")
+            ));
+        }
+        Ok(InputProfile::ALL
+            .into_iter()
+            .find(|p| p.name() == text)
+            .map_or_else(
+                || InputSource::File(PathBuf::from(text)),
+                InputSource::Profile,
+            ))
+    }
+}
+
 // The options of `motorcal simulate`, as the command line and the tests give them.
 #[derive(clap::Args, Clone, Debug)]
 pub struct SimulateOptions {
@@ -35,16 +67,19 @@ pub struct SimulateOptions {
     pub out: PathBuf,
     #[arg(long, default_value_t = DEFAULT_SEED)]
     pub seed: u64,
-    #[arg(long, value_enum, default_value_t = InputProfile::Constant)]
-    pub input: InputProfile,
+    /// The input: a profile (constant, step, reversal, square) or the path of a `t,U` file
+    /// (a designed or recorded input), whose times the recording then takes.
+    #[arg(long, default_value = "constant", value_parser = InputSource::parse)]
+    pub input: InputSource,
     /// Noise standard deviations of I [A] and ω [rad/s].
     #[arg(long, num_args = 2, value_names = ["SD_I", "SD_OMEGA"], default_values_t = [2.0, 10.0])]
     pub noise_sd: Vec<f64>,
-    #[arg(long, default_value_t = 501)]
-    pub samples: usize,
-    /// Length of the record [s].
-    #[arg(long, default_value_t = 0.5)]
-    pub t_end: f64,
+    /// Samples of the record (default 501; an input file's rows otherwise).
+    #[arg(long)]
+    pub samples: Option<usize>,
+    /// Length of the record [s] (default 0.5; an input file's last time otherwise).
+    #[arg(long)]
+    pub t_end: Option<f64>,
     /// A concealed-physics case instead: the hidden effect(s) (a term name, two comma
     /// separated, or `none`); writes recording.csv, motor.toml and answer.json.
     #[arg(long, value_delimiter = ',', conflicts_with_all = ["truth", "nominal"])]
@@ -64,10 +99,10 @@ impl Default for SimulateOptions {
             nominal: None,
             out: PathBuf::from("simulated"),
             seed: DEFAULT_SEED,
-            input: InputProfile::Constant,
+            input: InputSource::Profile(InputProfile::Constant),
             noise_sd: vec![2.0, 10.0],
-            samples: 501,
-            t_end: 0.5,
+            samples: None,
+            t_end: None,
             effect: None,
             magnitude: None,
             conceal: false,
@@ -80,11 +115,18 @@ impl Default for SimulateOptions {
 pub fn run(options: &SimulateOptions) -> Result<(), AppError> {
     let out = &options.out;
     if let Some(effects) = &options.effect {
+        let InputSource::Profile(input) = options.input else {
+            return Err(AppError::Usage(
+                "--input FILE cannot be combined with --effect: a concealed case draws its input \
+                 from the profiles"
+                    .into(),
+            ));
+        };
         let answer = super::cases::write_case(
             &crate::study::cases::CaseOptions {
                 effects: effects.clone(),
                 magnitude: options.magnitude,
-                input: options.input,
+                input,
                 seed: options.seed,
                 conceal: options.conceal,
             },
@@ -132,29 +174,6 @@ pub struct SimulateReport {
 }
 
 pub fn simulate(options: &SimulateOptions) -> Result<SimulateReport, AppError> {
-    if options.samples < 2 {
-        return Err(AppError::Usage(format!(
-            "--samples {} : need at least 2 samples",
-            options.samples
-        )));
-    }
-    if !(options.t_end > 0.0 && options.t_end.is_finite()) {
-        return Err(AppError::Usage(format!(
-            "--t-end {} : must be a positive number of seconds",
-            options.t_end
-        )));
-    }
-    if options.noise_sd.len() != 2
-        || options
-            .noise_sd
-            .iter()
-            .any(|s| !(*s >= 0.0 && s.is_finite()))
-    {
-        return Err(AppError::Usage(format!(
-            "--noise-sd {:?} : must be non-negative numbers",
-            options.noise_sd
-        )));
-    }
     let truth_file = match &options.truth {
         Some(path) => read_model_file(path)?,
         None => ModelFile::default(),
@@ -167,8 +186,51 @@ pub fn simulate(options: &SimulateOptions) -> Result<SimulateReport, AppError> {
             ..ModelFile::default()
         },
     };
-    let times = sample_times(options.t_end, options.samples);
-    let input = options.input.voltage(truth_file.motor.voltage, &times);
+    let (times, input) = match &options.input {
+        InputSource::File(path) => {
+            if options.samples.is_some() || options.t_end.is_some() {
+                return Err(AppError::Usage(format!(
+                    "--samples and --t-end cannot be given with --input {}: the file's times are \
+                     the record's",
+                    path.display()
+                )));
+            }
+            let profile = read_voltage_profile(path)?;
+            let input = VoltageInput::Held {
+                times: profile.times.clone(),
+                values: profile.values,
+            };
+            (profile.times, input)
+        }
+        InputSource::Profile(profile) => {
+            let samples = options.samples.unwrap_or(DEFAULT_SAMPLES);
+            let t_end = options.t_end.unwrap_or(DEFAULT_T_END);
+            if samples < 2 {
+                return Err(AppError::Usage(format!(
+                    "--samples {samples} : need at least 2 samples"
+                )));
+            }
+            if !(t_end > 0.0 && t_end.is_finite()) {
+                return Err(AppError::Usage(format!(
+                    "--t-end {t_end} : must be a positive number of seconds"
+                )));
+            }
+            let times = sample_times(t_end, samples);
+            let input = profile.voltage(truth_file.motor.voltage, &times);
+            (times, input)
+        }
+    };
+    if options.noise_sd.len() != 2
+        || options
+            .noise_sd
+            .iter()
+            .any(|s| !(*s >= 0.0 && s.is_finite()))
+    {
+        return Err(AppError::Usage(format!(
+            "--noise-sd {:?} : must be non-negative numbers",
+            options.noise_sd
+        )));
+    }
     let model = truth_file
         .model(input.clone())
         .map_err(|e| AppError::Usage(format!("--truth: {e}")))?;

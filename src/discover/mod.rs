@@ -75,6 +75,7 @@ pub use settings::{
     LAPLACE_DRAWS, MAX_TERMS, METRIC_ADAPTATION, MIN_SAMPLES, candidate_names, uses_laplace,
 };
 pub use state::{StateFingerprint, records_reverse};
+pub use ties::TIE_EXPERIMENTS;
 pub use unexplained::{Fingerprint, Span, Unexplained, UnexplainedFigure};
 
 use crate::bayes::ModelSettings;

@@ -12,8 +12,9 @@ use crate::synthetic::generate;
 
 use super::candidate::{Candidate, fit_candidate};
 
-/// The inputs tried, in the order a user would rather run them.
-const INPUTS: [InputProfile; 2] = [InputProfile::Reversal, InputProfile::Step];
+/// The inputs tried, in the order a user would rather run them (`design` reports its designed
+/// input's gap beside theirs).
+pub const TIE_EXPERIMENTS: [InputProfile; 2] = [InputProfile::Reversal, InputProfile::Step];
 
 /// The first input on which `selected` beats `other` by more than `threshold`, if any.
 pub fn separating_input(
@@ -28,7 +29,7 @@ pub fn separating_input(
     if base.model.base.is_drive() {
         return reversed_record(base, &truth, selected, other, noise_sd, threshold, seed);
     }
-    for input in INPUTS {
+    for input in TIE_EXPERIMENTS {
         let recording = &base.recordings[0];
         let model_file = &truth.model;
         let voltage = input.voltage(model_file.motor.voltage, &recording.time);

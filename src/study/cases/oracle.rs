@@ -105,7 +105,9 @@ fn residual_ss(out: &[f64], target: &[f64], weights: &[f64]) -> f64 {
         .sum()
 }
 
-fn levenberg_marquardt(
+/// Projected Levenberg–Marquardt from `theta` on the weighted residual `(target − G(θ))·w`:
+/// the weighted sum of squares where it stops, and the estimate there.
+pub fn levenberg_marquardt(
     forward: &crate::forward::ForwardModel,
     specs: &[crate::parameter::ParameterSpec],
     target: &[f64],

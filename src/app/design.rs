@@ -1,0 +1,409 @@
+//! `motorcal design`: the input to record next, within the drive's limits, that tells the
+//! candidates of a diagnosis apart or pins named parameters; writes input.csv, design.json and
+//! design.png. The science is `crate::design`'s.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use serde_json::{Value, json};
+
+use crate::design::{
+    self, Candidate, DesignSettings, Experiment, Limits, SearchSettings, Target, design_problem,
+    design_times,
+};
+use crate::io::{VoltageProfile, read_model_file, write_atomically, write_voltage_profile};
+use crate::motor::{MotorParam, VoltageInput};
+use crate::plot::{ChannelPrediction, PredictivePlot, posterior_predictive};
+
+use super::AppError;
+
+// The options of `motorcal design`, as the command line and the tests give them.
+#[derive(clap::Args, Clone, Debug)]
+pub struct DesignArgs {
+    /// The user's model file (not the amended one).
+    #[arg(long)]
+    pub model: PathBuf,
+    /// A `diagnose --json` report: the candidates' fits and the noise σ.
+    #[arg(long)]
+    pub diagnosis: Option<PathBuf>,
+    /// Candidates to tell apart (default: the diagnosis's selected term and its ties).
+    #[arg(long, value_delimiter = ',')]
+    pub separate: Option<Vec<String>>,
+    /// Parameters to pin (`R`, `coulomb_friction.T_c`, or a ratio `c_g/J`).
+    #[arg(long, value_delimiter = ',', conflicts_with = "separate")]
+    pub pin: Option<Vec<String>>,
+    /// Length of the record [s].
+    #[arg(long)]
+    pub duration: f64,
+    /// Sampling rate [Hz].
+    #[arg(long)]
+    pub rate: f64,
+    /// The drive's limits, e.g. U=±24,I=±300,omega=±3000.
+    #[arg(long, allow_hyphen_values = true)]
+    pub limits: String,
+    /// Voltage segments of the designed input.
+    #[arg(long, default_value_t = 8)]
+    pub segments: usize,
+    #[arg(long, default_value_t = 2026)]
+    pub seed: u64,
+    /// Noise σ of I [A] and ω [rad/s] (default: the diagnosis's, else the paper's 2 and 10).
+    #[arg(long, num_args = 2, value_names = ["SD_I", "SD_OMEGA"])]
+    pub noise_sd: Option<Vec<f64>>,
+    /// Search starts (run in parallel).
+    #[arg(long, default_value_t = 4)]
+    pub starts: usize,
+    /// Noisy records per candidate for the reported gap and its spread.
+    #[arg(long, default_value_t = design::DEFAULT_DRAWS)]
+    pub draws: usize,
+    /// Output folder for input.csv, design.json and design.png.
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+/// `motorcal design`: search, write, say what it wrote.
+pub fn run(args: &DesignArgs) -> Result<(), AppError> {
+    let started = Instant::now();
+    let limits: Limits = args
+        .limits
+        .parse()
+        .map_err(|e| AppError::Usage(format!("--limits {}: {e}", args.limits)))?;
+    let model = read_model_file(&args.model)?;
+    let times = design_times(args.duration, args.rate)?;
+    let base = design_problem(&model, &times)?;
+    let diagnosis = args.diagnosis.as_deref().map(read_diagnosis).transpose()?;
+    let noise_sd = noise_sd(args, diagnosis.as_ref())?;
+    let settings = DesignSettings {
+        search: SearchSettings {
+            segments: args.segments,
+            starts: args.starts.max(1),
+            seed: args.seed,
+            ..SearchSettings::default()
+        },
+        limits,
+        draws: args.draws.max(2),
+    };
+    if args.segments == 0 {
+        return Err(AppError::Usage(
+            "--segments 0 : a design needs at least one".into(),
+        ));
+    }
+    let (report, values, figure) = if let Some(pins) = &args.pin {
+        let targets: Vec<Target> = pins.iter().map(|p| Target::parse(p)).collect();
+        let candidate = design::pin_candidate(&base, &BTreeMap::new(), &targets)?;
+        let experiment = Experiment {
+            candidates: vec![candidate.clone()],
+            times: times.clone(),
+            noise_sd: noise_sd.clone(),
+        };
+        let d = design::pin(&candidate, &experiment, &targets, &settings)?;
+        let input = design::held(&d.times, d.values.clone());
+        let (_, y, _) = prediction(&experiment, 0, &input)?;
+        let report = json!({
+            "objective": "pin",
+            "targets": targets.iter().map(Target::name).collect::<Vec<_>>(),
+            "expected_sd": d.pinned.sd,
+            "expected_relative_sd": d.pinned.relative_sd,
+            "log_det_covariance": d.pinned.log_det,
+            "fixed_experiments": d.fixed_experiments.iter().map(|(c, p)| json!({
+                "input": c.input, "within_limits": c.within_limits, "peaks": c.peaks,
+                "expected_sd": p.sd, "expected_relative_sd": p.relative_sd,
+            })).collect::<Vec<_>>(),
+            "profile": d.profile, "peaks": d.check.peaks,
+        });
+        let figure = Figure {
+            title: format!("design: pin {}", pins.join(", ")),
+            truth: y.clone(),
+            rival: y,
+        };
+        (report, d.values, figure)
+    } else {
+        let Some(diagnosis) = &diagnosis else {
+            return Err(AppError::Usage(
+                "--diagnosis is needed to separate candidates (their fits and the noise), or \
+                 give --pin"
+                    .into(),
+            ));
+        };
+        let names = match &args.separate {
+            Some(names) => names.clone(),
+            None => default_candidates(diagnosis)?,
+        };
+        if names.len() < 2 {
+            return Err(AppError::Usage(format!(
+                "--separate {}: name at least two candidates",
+                names.join(",")
+            )));
+        }
+        let candidates = names
+            .iter()
+            .map(|name| {
+                design::parse_candidate(name)?;
+                let values = candidate_values(diagnosis, name)?;
+                Ok(Candidate::new(&base, name, &values)?)
+            })
+            .collect::<Result<Vec<_>, AppError>>()?;
+        let experiment = Experiment {
+            candidates,
+            times: times.clone(),
+            noise_sd: noise_sd.clone(),
+        };
+        let d = design::separate(&experiment, &settings)?;
+        let input = design::held(&d.times, d.values.clone());
+        let curves = design::lead_curves(&experiment, &input)?;
+        let report = json!({
+            "objective": "separate",
+            "candidates": names,
+            "expected_gap_nats": d.expected_gap_nats,
+            "expected_gap_sd_nats": d.spread_nats,
+            "gaps": d.gaps,
+            "fixed_experiments": d.fixed_experiments.iter().map(|f| json!({
+                "input": f.check.input, "expected_gap_nats": f.expected_gap_nats,
+                "expected_gap_sd_nats": f.spread_nats, "within_limits": f.check.within_limits,
+                "peaks": f.check.peaks, "gaps": f.gaps,
+            })).collect::<Vec<_>>(),
+            "profile": d.profile, "peaks": d.check.peaks,
+        });
+        let figure = Figure {
+            title: format!(
+                "design: {} as truth (line, ±2σ band) against {} fitted to it (points)",
+                experiment.candidates[curves.lead.truth].name,
+                experiment.candidates[curves.lead.rival].name
+            ),
+            truth: curves.truth,
+            rival: curves.rival_fit,
+        };
+        (report, d.values, figure)
+    };
+    let mut report = report;
+    report["limits"] = json!(limits);
+    report["seed"] = json!(args.seed);
+    report["duration_s"] = json!(args.duration);
+    report["rate_hz"] = json!(args.rate);
+    report["segments"] = json!(args.segments);
+    report["noise_sd"] = json!({"I": noise_sd[0], "omega": noise_sd[1]});
+    report["search"] = json!(settings.search);
+    report["draws"] = json!(settings.draws);
+    report["runtime_s"] = json!(started.elapsed().as_secs_f64());
+    report["provenance"] = json!(
+        crate::io::provenance()
+            .into_iter()
+            .collect::<BTreeMap<_, _>>()
+    );
+    write_outputs(&args.out, &times, &values, &report, &figure, &noise_sd)?;
+    print_summary(&report, &args.out);
+    Ok(())
+}
+
+/// The noise-free prediction of candidate `c` under `input`, with its channels' names.
+fn prediction(
+    experiment: &Experiment,
+    c: usize,
+    input: &VoltageInput,
+) -> Result<(Vec<String>, Vec<f64>, usize), AppError> {
+    let forward = experiment.candidates[c].forward(input, &experiment.times)?;
+    let mut y = vec![0.0; forward.n_outputs()];
+    forward
+        .simulate(&experiment.candidates[c].theta, &mut y)
+        .map_err(|e| AppError::Numerical(e.to_string()))?;
+    let names = forward.channels().iter().map(|s| s.to_string()).collect();
+    Ok((names, y, experiment.times.len()))
+}
+
+struct Figure {
+    title: String,
+    truth: Vec<f64>,
+    rival: Vec<f64>,
+}
+
+fn read_diagnosis(path: &Path) -> Result<Value, AppError> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| AppError::Usage(format!("--diagnosis {}: {e}", path.display())))?;
+    let value: Value = serde_json::from_str(&text).map_err(|e| {
+        AppError::Usage(format!(
+            "--diagnosis {}:{}: not a diagnose --json report: {e}",
+            path.display(),
+            e.line()
+        ))
+    })?;
+    if !value["ranking"].is_array() {
+        return Err(AppError::Usage(format!(
+            "--diagnosis {}: field 'ranking' missing: not a diagnose --json report",
+            path.display()
+        )));
+    }
+    Ok(value)
+}
+
+/// The selected term and its ties.
+fn default_candidates(diagnosis: &Value) -> Result<Vec<String>, AppError> {
+    let mut names = vec![diagnosis["selected"].as_str().unwrap_or("none").to_string()];
+    for tie in diagnosis["ties"].as_array().into_iter().flatten() {
+        if let Some(t) = tie.as_str() {
+            names.push(t.to_string());
+        }
+    }
+    if names.len() < 2 {
+        return Err(AppError::Usage(
+            "the diagnosis reports no tie: name the candidates with --separate".into(),
+        ));
+    }
+    Ok(names)
+}
+
+/// A candidate's fitted values from the diagnosis's ranking, keyed as the model's parameters.
+fn candidate_values(diagnosis: &Value, name: &str) -> Result<BTreeMap<String, f64>, AppError> {
+    let entry = diagnosis["ranking"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .find(|e| e["effect"].as_str() == Some(name))
+        .ok_or_else(|| {
+            AppError::Usage(format!(
+                "--separate {name}: the diagnosis's ranking has no fit of '{name}'"
+            ))
+        })?;
+    let base: Vec<&str> = MotorParam::ALL.iter().map(|p| p.key()).collect();
+    let mut values = BTreeMap::new();
+    for (key, v) in entry["params"].as_object().into_iter().flatten() {
+        let Some(v) = v.as_f64() else { continue };
+        if key == "I_sat" {
+            continue;
+        }
+        let key = if base.contains(&key.as_str()) || key.contains('.') {
+            key.clone()
+        } else {
+            format!("{name}.{key}")
+        };
+        values.insert(key, v);
+    }
+    Ok(values)
+}
+
+fn noise_sd(args: &DesignArgs, diagnosis: Option<&Value>) -> Result<Vec<f64>, AppError> {
+    if let Some(sd) = &args.noise_sd {
+        if sd.iter().any(|s| !(*s > 0.0 && s.is_finite())) {
+            return Err(AppError::Usage(format!(
+                "--noise-sd {sd:?} : must be positive numbers"
+            )));
+        }
+        return Ok(sd.clone());
+    }
+    for fit in ["fit_after", "fit_before"] {
+        let sigma = diagnosis.map(|d| &d[fit]["sigma"]);
+        if let Some(s) = sigma
+            && let (Some(i), Some(w)) = (s["I"].as_f64(), s["omega"].as_f64())
+        {
+            return Ok(vec![i, w]);
+        }
+    }
+    Ok(crate::study::cases::NOISE_SD.to_vec())
+}
+
+fn write_outputs(
+    out: &Path,
+    times: &[f64],
+    values: &[f64],
+    report: &Value,
+    figure: &Figure,
+    noise_sd: &[f64],
+) -> Result<(), AppError> {
+    std::fs::create_dir_all(out)?;
+    write_voltage_profile(
+        &out.join("input.csv"),
+        &VoltageProfile {
+            times: times.to_vec(),
+            values: values.to_vec(),
+        },
+    )?;
+    let text = serde_json::to_string_pretty(report).map_err(|e| AppError::Output(e.to_string()))?;
+    write_atomically(&out.join("design.json"), text.as_bytes())?;
+    let m = times.len();
+    let mut channels = vec![ChannelPrediction {
+        name: "U".into(),
+        unit: "V".into(),
+        measured: values.to_vec(),
+        model: values.to_vec(),
+        mean: values.to_vec(),
+        lower: values.to_vec(),
+        upper: values.to_vec(),
+        sigma: 0.0,
+    }];
+    for (c, (name, unit)) in [("I", "A"), ("ω", "rad/s")].into_iter().enumerate() {
+        let truth = figure.truth[c * m..(c + 1) * m].to_vec();
+        let band = 2.0 * noise_sd[c];
+        channels.push(ChannelPrediction {
+            name: name.into(),
+            unit: unit.into(),
+            measured: figure.rival[c * m..(c + 1) * m].to_vec(),
+            model: figure.rival[c * m..(c + 1) * m].to_vec(),
+            lower: truth.iter().map(|v| v - band).collect(),
+            upper: truth.iter().map(|v| v + band).collect(),
+            mean: truth,
+            sigma: noise_sd[c],
+        });
+    }
+    posterior_predictive(
+        &out.join("design.png"),
+        &PredictivePlot {
+            title: figure.title.clone(),
+            times: times.to_vec(),
+            channels,
+        },
+    )
+    .map_err(|e| AppError::Output(e.to_string()))?;
+    Ok(())
+}
+
+fn print_summary(report: &Value, out: &Path) {
+    let f = |v: &Value| v.as_f64().map_or("—".to_string(), |x| format!("{x:.2}"));
+    if report["objective"] == "separate" {
+        println!(
+            "designed input: expected gap {} ± {} nats (worst truth)",
+            f(&report["expected_gap_nats"]),
+            f(&report["expected_gap_sd_nats"])
+        );
+        for g in report["gaps"].as_array().into_iter().flatten() {
+            println!(
+                "  {} as truth over {}: {} ± {} nats (noise-free {})",
+                g["truth"].as_str().unwrap_or(""),
+                g["rival"].as_str().unwrap_or(""),
+                f(&g["expected_gap_nats"]),
+                f(&g["sd_nats"]),
+                f(&g["noise_free_gap_nats"])
+            );
+        }
+        for e in report["fixed_experiments"].as_array().into_iter().flatten() {
+            println!(
+                "{:>9} input: expected gap {} ± {} nats{}",
+                e["input"].as_str().unwrap_or(""),
+                f(&e["expected_gap_nats"]),
+                f(&e["expected_gap_sd_nats"]),
+                if e["within_limits"] == true {
+                    ""
+                } else {
+                    " (passes the limits)"
+                }
+            );
+        }
+    } else {
+        println!("designed input: expected sd {}", report["expected_sd"]);
+        for e in report["fixed_experiments"].as_array().into_iter().flatten() {
+            println!(
+                "{:>9} input: expected sd {}{}",
+                e["input"].as_str().unwrap_or(""),
+                e["expected_sd"],
+                if e["within_limits"] == true {
+                    ""
+                } else {
+                    " (passes the limits)"
+                }
+            );
+        }
+    }
+    println!(
+        "wrote {} (input.csv, design.json, design.png) in {:.1} s",
+        out.display(),
+        report["runtime_s"].as_f64().unwrap_or(0.0)
+    );
+}

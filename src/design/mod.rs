@@ -1,0 +1,328 @@
+//! `motorcal design`: the input to record next. Within the drive's limits, a piecewise-constant
+//! voltage of N segments that either tells candidate explanations apart (the expected evidence
+//! gap of each candidate as the truth over its best-fitting rival, [`separate`]) or pins named
+//! parameters (D-optimal on the Fisher matrix of the forward sensitivities, [`pin`]); beside it
+//! the fixed experiments `diagnose` tries for a tie ([`crate::discover::TIE_EXPERIMENTS`]) and
+//! for pinning the model's constant U.
+//!
+//! The files: `profile` (the input and its free coordinates), `limits`, `experiment` (the
+//! candidates at their estimates, the sampling and σ), `separate` and `pin` (the objectives),
+//! `search` (multi-start Nelder–Mead). Nothing here reads or writes a file: `app::design` does.
+//!
+//! **Limits.** An input is judged on the noise-free predictions of every candidate at the
+//! record's samples: one whose |I| or |ω| passes its limit there is refused. The search runs on
+//! the continuous switching times with the current and speed limits 2% tighter ([`MARGIN`]);
+//! the input written switches at the first sample at or after each switching time, and is
+//! checked again against the limits themselves — an input that then passes one is an error,
+//! never clipped.
+
+mod experiment;
+mod limits;
+mod pin;
+mod profile;
+mod search;
+mod separate;
+
+pub use experiment::{Candidate, Experiment, design_problem, design_times, parse_candidate};
+pub use limits::Limits;
+pub use pin::{Pinned, Target, fisher, pin_candidate, pinned};
+pub use profile::{Profile, held};
+pub use search::SearchSettings;
+pub use separate::{
+    Evaluation, ExpectedGap, Lead, LeadCurves, expected_gaps, lead_curves, noise_free_leads,
+    predictions,
+};
+
+use crate::error::Error;
+use crate::motor::VoltageInput;
+use crate::study::InputProfile;
+
+/// The search keeps |I| and |ω| this fraction inside their limits (see the module's notes).
+pub const MARGIN: f64 = 0.98;
+
+/// Monte Carlo records per truth for a reported gap.
+pub const DEFAULT_DRAWS: usize = 20;
+
+/// What the search's cost is when an input passes the limits: above any feasible cost, and
+/// smaller the less it passes them.
+const INFEASIBLE: f64 = 1e6;
+
+#[derive(Clone, Copy, Debug)]
+pub struct DesignSettings {
+    pub search: SearchSettings,
+    pub limits: Limits,
+    /// Monte Carlo records per truth for the reported gaps.
+    pub draws: usize,
+}
+
+/// An input other than the designed one, with where it takes the motor.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct InputCheck {
+    pub input: String,
+    pub within_limits: bool,
+    /// Peak |I| and |ω| over the candidates.
+    pub peaks: std::collections::BTreeMap<String, f64>,
+}
+
+/// A fixed experiment's gaps, for comparison.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct FixedSeparation {
+    #[serde(flatten)]
+    pub check: InputCheck,
+    /// The smallest expected gap over the truths.
+    pub expected_gap_nats: f64,
+    pub spread_nats: f64,
+    pub gaps: Vec<ExpectedGap>,
+}
+
+/// The designed separating input.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct SeparationDesign {
+    pub profile: Profile,
+    pub times: Vec<f64>,
+    /// The voltage at each sample time: `input.csv`.
+    pub values: Vec<f64>,
+    pub check: InputCheck,
+    /// The smallest expected gap over the truths (the design's guarantee), its truth's sd.
+    pub expected_gap_nats: f64,
+    pub spread_nats: f64,
+    pub gaps: Vec<ExpectedGap>,
+    pub fixed_experiments: Vec<FixedSeparation>,
+}
+
+/// The designed pinning input.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct PinDesign {
+    pub profile: Profile,
+    pub times: Vec<f64>,
+    pub values: Vec<f64>,
+    pub check: InputCheck,
+    pub pinned: Pinned,
+    pub fixed_experiments: Vec<(InputCheck, Pinned)>,
+}
+
+fn no_limits() -> Limits {
+    Limits {
+        voltage: f64::INFINITY,
+        current: f64::INFINITY,
+        speed: f64::INFINITY,
+    }
+}
+
+fn check(
+    experiment: &Experiment,
+    name: &str,
+    input: &VoltageInput,
+    limits: &Limits,
+) -> Result<InputCheck, Error> {
+    let mut peaks = std::collections::BTreeMap::new();
+    let mut within = true;
+    for c in &experiment.candidates {
+        let forward = c.forward(input, &experiment.times)?;
+        let mut y = vec![0.0; forward.n_outputs()];
+        forward
+            .simulate(&c.theta, &mut y)
+            .map_err(|e| Error::Numerical(e.to_string()))?;
+        within &= limits.excess(forward.channels(), &y) == 0.0;
+        for (channel, peak) in limits.peaks(forward.channels(), &y) {
+            let slot = peaks.entry(channel).or_insert(0.0f64);
+            *slot = slot.max(peak);
+        }
+    }
+    if let VoltageInput::Held { values, .. } = input {
+        within &= values.iter().all(|u| u.abs() <= limits.voltage);
+    }
+    Ok(InputCheck {
+        input: name.into(),
+        within_limits: within,
+        peaks,
+    })
+}
+
+/// Refuses limits that no useful input can meet: a constant 1% of the voltage limit already
+/// drives a candidate past the current or speed limit.
+fn check_possible(experiment: &Experiment, limits: &Limits) -> Result<(), Error> {
+    let u = 0.01 * limits.voltage;
+    let input = held(&experiment.times, vec![u; experiment.times.len()]);
+    let c = check(experiment, "probe", &input, limits)?;
+    if !c.within_limits {
+        let peaks: Vec<String> = c
+            .peaks
+            .iter()
+            .map(|(k, v)| format!("|{k}| {v:.3}"))
+            .collect();
+        return Err(Error::setting(
+            "limits",
+            format!(
+                "U=±{},I=±{},omega=±{}",
+                limits.voltage, limits.current, limits.speed
+            ),
+            format!(
+                "no input can meet these limits: a constant {u} V (1% of the voltage limit) \
+                 already reaches {}",
+                peaks.join(", ")
+            ),
+        ));
+    }
+    Ok(())
+}
+
+fn tightened(limits: &Limits) -> Limits {
+    Limits {
+        current: limits.current * MARGIN,
+        speed: limits.speed * MARGIN,
+        ..*limits
+    }
+}
+
+/// The search on `cost`, the profile it ends at, and that profile sampled and checked.
+fn search_profile<F: Fn(&VoltageInput) -> f64 + Sync>(
+    experiment: &Experiment,
+    settings: &DesignSettings,
+    cost: F,
+) -> Result<(Profile, Vec<f64>, VoltageInput, InputCheck), Error> {
+    let duration = *experiment.times.last().unwrap_or(&0.0);
+    let n = settings.search.segments;
+    if n < 1 {
+        return Err(Error::setting(
+            "segments",
+            n,
+            "a design needs at least one segment",
+        ));
+    }
+    let u_max = settings.limits.voltage;
+    let starts: Vec<Vec<f64>> = search::starts(&settings.search, duration, u_max)
+        .iter()
+        .map(|p| p.to_free(u_max))
+        .collect();
+    let free = |z: &[f64]| cost(&Profile::from_free(z, n, duration, u_max).continuous());
+    let (z, _) = search::minimise(&starts, settings.search.iterations, &free);
+    let profile = Profile::from_free(&z, n, duration, u_max);
+    let values = profile.sampled(&experiment.times);
+    let input = held(&experiment.times, values.clone());
+    let c = check(experiment, "designed", &input, &settings.limits)?;
+    if !c.within_limits {
+        return Err(Error::Numerical(format!(
+            "the best input the search found passes the limits once sampled (peaks {:?}); it is \
+             refused rather than clipped: try more segments or another seed",
+            c.peaks
+        )));
+    }
+    Ok((profile, values, input, c))
+}
+
+/// The fixed experiments at the model's U: (name, input).
+fn fixed_inputs(experiment: &Experiment, profiles: &[InputProfile]) -> Vec<(String, VoltageInput)> {
+    let u = experiment
+        .candidates
+        .first()
+        .map_or(0.0, |c| c.problem.model.motor.voltage);
+    profiles
+        .iter()
+        .map(|p| {
+            let input = match p.voltage(u, &experiment.times) {
+                VoltageInput::Constant => held(&experiment.times, vec![u; experiment.times.len()]),
+                held => held,
+            };
+            (p.name().to_string(), input)
+        })
+        .collect()
+}
+
+fn worst(gaps: &[ExpectedGap]) -> (f64, f64) {
+    gaps.iter()
+        .map(|g| (g.expected_gap_nats, g.sd_nats))
+        .fold((f64::INFINITY, 0.0), |a, b| if b.0 < a.0 { b } else { a })
+}
+
+/// Designs the input that separates the experiment's candidates (at least two).
+pub fn separate(
+    experiment: &Experiment,
+    settings: &DesignSettings,
+) -> Result<SeparationDesign, Error> {
+    if experiment.candidates.len() < 2 {
+        return Err(Error::setting(
+            "separate",
+            experiment.candidates.len(),
+            "separating needs at least two candidates",
+        ));
+    }
+    check_possible(experiment, &settings.limits)?;
+    let search_limits = tightened(&settings.limits);
+    let cost =
+        |input: &VoltageInput| match noise_free_leads(experiment, input, &search_limits, false) {
+            Ok(Evaluation::Infeasible { excess }) => INFEASIBLE * (1.0 + excess),
+            Ok(e) => -e.worst(),
+            Err(_) => INFEASIBLE * 1e3,
+        };
+    let (profile, values, input, check) = search_profile(experiment, settings, cost)?;
+    let seed = settings.search.seed;
+    let gaps = expected_gaps(experiment, &input, &settings.limits, settings.draws, seed)?;
+    let (expected_gap_nats, spread_nats) = worst(&gaps);
+    let mut fixed_experiments = Vec::new();
+    for (name, fixed) in fixed_inputs(experiment, &crate::discover::TIE_EXPERIMENTS) {
+        let check = self::check(experiment, &name, &fixed, &settings.limits)?;
+        let gaps = expected_gaps(experiment, &fixed, &no_limits(), settings.draws, seed)?;
+        let (g, s) = worst(&gaps);
+        fixed_experiments.push(FixedSeparation {
+            check,
+            expected_gap_nats: g,
+            spread_nats: s,
+            gaps,
+        });
+    }
+    Ok(SeparationDesign {
+        profile,
+        times: experiment.times.clone(),
+        values,
+        check,
+        expected_gap_nats,
+        spread_nats,
+        gaps,
+        fixed_experiments,
+    })
+}
+
+/// Designs the input that pins `targets` of `candidate` (the experiment's candidates are only
+/// used for the limits check: pass the candidate itself).
+pub fn pin(
+    candidate: &Candidate,
+    experiment: &Experiment,
+    targets: &[Target],
+    settings: &DesignSettings,
+) -> Result<PinDesign, Error> {
+    check_possible(experiment, &settings.limits)?;
+    let search_limits = tightened(&settings.limits);
+    let cost = |input: &VoltageInput| match pin::pin_cost(
+        candidate,
+        experiment,
+        targets,
+        input,
+        &search_limits,
+    ) {
+        Ok(Ok(log_det)) if log_det.is_finite() => log_det,
+        Ok(Ok(_)) => INFEASIBLE,
+        Ok(Err(excess)) => INFEASIBLE * (1.0 + excess),
+        Err(_) => INFEASIBLE * 1e3,
+    };
+    let (profile, values, input, check) = search_profile(experiment, settings, cost)?;
+    let pinned = pinned(candidate, experiment, targets, &input)?;
+    let mut fixed_experiments = Vec::new();
+    let profiles = [
+        InputProfile::Constant,
+        crate::discover::TIE_EXPERIMENTS[0],
+        crate::discover::TIE_EXPERIMENTS[1],
+    ];
+    for (name, fixed) in fixed_inputs(experiment, &profiles) {
+        let check = self::check(experiment, &name, &fixed, &settings.limits)?;
+        fixed_experiments.push((check, self::pinned(candidate, experiment, targets, &fixed)?));
+    }
+    Ok(PinDesign {
+        profile,
+        times: experiment.times.clone(),
+        values,
+        check,
+        pinned,
+        fixed_experiments,
+    })
+}

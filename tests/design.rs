@@ -1,0 +1,243 @@
+//! `motorcal design`: every designed input stays within the limits under every candidate, bad
+//! options get one clear error and write nothing, and a small design runs end to end.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use motorcal::design::{
+    self, Candidate, DesignSettings, Experiment, Limits, SearchSettings, design_problem,
+    design_times,
+};
+use motorcal::io::{read_model_file, read_voltage_profile};
+
+fn fixture(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fixtures/design")
+        .join(name)
+}
+
+fn motorcal(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_motorcal"))
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("motorcal-design-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn one_error_line(o: &Output, needles: &[&str]) {
+    assert!(!o.status.success(), "expected a failure");
+    let err = String::from_utf8_lossy(&o.stderr);
+    let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert_eq!(lines.len(), 1, "expected one error line, got: {err}");
+    assert!(!err.contains("panicked"), "{err}");
+    for n in needles {
+        assert!(err.contains(n), "'{err}' does not mention '{n}'");
+    }
+}
+
+/// The two tied candidates of the fixture at the diagnosis's estimates, on a short record.
+fn tied_pair(duration: f64, rate: f64) -> Experiment {
+    let model = read_model_file(&fixture("motor.toml")).unwrap();
+    let times = design_times(duration, rate).unwrap();
+    let base = design_problem(&model, &times).unwrap();
+    let at = |pairs: &[(&str, f64)]| -> BTreeMap<String, f64> {
+        pairs.iter().map(|(k, v)| (k.to_string(), *v)).collect()
+    };
+    let candidates = vec![
+        Candidate::new(
+            &base,
+            "load_torque",
+            &at(&[("R", 0.10557), ("load_torque.T_0", 0.02452)]),
+        )
+        .unwrap(),
+        Candidate::new(
+            &base,
+            "coulomb_friction",
+            &at(&[("R", 0.10557), ("coulomb_friction.T_c", 0.02453)]),
+        )
+        .unwrap(),
+    ];
+    Experiment {
+        candidates,
+        times,
+        noise_sd: vec![2.0, 10.0],
+    }
+}
+
+#[test]
+fn designed_inputs_stay_within_the_limits() {
+    let experiment = tied_pair(0.1, 500.0);
+    // Limits that bind: 24 V would drive the current to 240 A.
+    for (seed, limits) in [
+        (1, "U=±24,I=±120,omega=±3000"),
+        (2, "U=±12,I=±300,omega=±400"),
+    ] {
+        let limits: Limits = limits.parse().unwrap();
+        let settings = DesignSettings {
+            search: SearchSettings {
+                segments: 4,
+                starts: 2,
+                iterations: 60,
+                seed,
+            },
+            limits,
+            draws: 2,
+        };
+        let d = design::separate(&experiment, &settings).unwrap();
+        assert!(d.values.iter().all(|u| u.abs() <= limits.voltage));
+        let input = design::held(&d.times, d.values.clone());
+        let (predictions, excess) = design::predictions(&experiment, &input, &limits).unwrap();
+        assert_eq!(excess, 0.0);
+        let m = d.times.len();
+        for y in &predictions {
+            assert!(y[..m].iter().all(|i| i.abs() <= limits.current));
+            assert!(y[m..].iter().all(|w| w.abs() <= limits.speed));
+        }
+        // The design uses what the limits allow: it is not the motor at rest.
+        assert!(d.values.iter().any(|u| u.abs() > 0.1 * limits.voltage));
+        assert!(d.expected_gap_nats.is_finite());
+    }
+}
+
+#[test]
+fn the_same_seed_gives_the_same_design_whatever_the_thread_count() {
+    let experiment = tied_pair(0.05, 400.0);
+    let settings = DesignSettings {
+        search: SearchSettings {
+            segments: 3,
+            starts: 2,
+            iterations: 40,
+            seed: 9,
+        },
+        limits: "U=±24,I=±300,omega=±3000".parse().unwrap(),
+        draws: 3,
+    };
+    let on = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| design::separate(&experiment, &settings).unwrap())
+    };
+    let (a, b) = (on(1), on(3));
+    assert_eq!(a.values, b.values);
+    assert_eq!(a.expected_gap_nats.to_bits(), b.expected_gap_nats.to_bits());
+}
+
+#[test]
+fn a_small_design_runs_end_to_end() {
+    let dir = scratch("e2e");
+    let out = dir.join("design");
+    let o = motorcal(&[
+        "design",
+        "--model",
+        fixture("motor.toml").to_str().unwrap(),
+        "--diagnosis",
+        fixture("diagnosis.json").to_str().unwrap(),
+        "--duration",
+        "0.05",
+        "--rate",
+        "400",
+        "--limits",
+        "U=±24,I=±300,omega=±3000",
+        "--segments",
+        "3",
+        "--starts",
+        "1",
+        "--draws",
+        "2",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let input = read_voltage_profile(&out.join("input.csv")).unwrap();
+    assert_eq!(input.times.len(), 20);
+    assert!(input.values.iter().all(|u| u.abs() <= 24.0));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("design.json")).unwrap()).unwrap();
+    assert!(json["expected_gap_nats"].is_f64());
+    assert!(json["expected_gap_sd_nats"].is_f64());
+    let fixed: Vec<&str> = json["fixed_experiments"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e["input"].as_str().unwrap())
+        .collect();
+    assert_eq!(fixed, ["reversal", "step"]);
+    assert_eq!(json["seed"], 2026);
+    assert_eq!(
+        json["candidates"],
+        serde_json::json!(["load_torque", "coulomb_friction"])
+    );
+    assert!(json["peaks"]["I"].as_f64().unwrap() <= 300.0);
+    assert!(out.join("design.png").exists());
+
+    // The loop closes: simulate takes the designed input.
+    let sim = dir.join("sim");
+    let o = motorcal(&[
+        "simulate",
+        "--input",
+        out.join("input.csv").to_str().unwrap(),
+        "--out",
+        sim.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
+#[test]
+fn bad_options_get_one_clear_error_and_write_nothing() {
+    let dir = scratch("bad");
+    let out = dir.join("design");
+    let model = fixture("motor.toml");
+    let diagnosis = fixture("diagnosis.json");
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "design",
+            "--model",
+            model.to_str().unwrap(),
+            "--diagnosis",
+            diagnosis.to_str().unwrap(),
+            "--rate",
+            "400",
+            "--segments",
+            "3",
+            "--starts",
+            "1",
+            "--draws",
+            "2",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        motorcal(&args)
+    };
+    let limits = "U=±24,I=±300,omega=±3000";
+    let o = run(&["--duration", "0.02", "--limits", limits]);
+    one_error_line(&o, &["--duration", "8 samples", "ten"]);
+    let o = run(&[
+        "--duration",
+        "0.05",
+        "--limits",
+        limits,
+        "--separate",
+        "load_torque,coulomb_fricton",
+    ]);
+    one_error_line(&o, &["coulomb_fricton", "unknown candidate"]);
+    let o = run(&[
+        "--duration",
+        "0.05",
+        "--limits",
+        "U=±24,I=±0.001,omega=±3000",
+    ]);
+    one_error_line(&o, &["--limits", "no input can meet"]);
+    let o = run(&["--duration", "0.05", "--limits", "U=±24,I=±300"]);
+    one_error_line(&o, &["--limits", "all three"]);
+    assert!(!out.exists());
+}

@@ -1,0 +1,122 @@
+//! `simulate --input FILE`: a `t,U` file drives the motor at its own times, the recording
+//! carries the U column, and a bad file gets one clear error and writes nothing.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+use motorcal::io::{ChannelMap, read_recording};
+
+fn motorcal(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_motorcal"))
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("motorcal-siminput-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn one_error_line(o: &Output, needles: &[&str]) {
+    assert!(!o.status.success(), "expected a failure");
+    let err = String::from_utf8_lossy(&o.stderr);
+    let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert_eq!(lines.len(), 1, "expected one error line, got: {err}");
+    assert!(!err.contains("panicked"), "{err}");
+    for n in needles {
+        assert!(err.contains(n), "'{err}' does not mention '{n}'");
+    }
+}
+
+#[test]
+fn an_input_file_drives_the_recording_at_its_times() {
+    let dir = scratch("file");
+    let input = dir.join("input.csv");
+    let mut text = String::from("t,U\n");
+    for i in 1..=200 {
+        let t = i as f64 * 1e-3;
+        let u = if i <= 120 { 12.0 } else { -6.0 };
+        text.push_str(&format!("{t},{u}\n"));
+    }
+    std::fs::write(&input, &text).unwrap();
+    let out = dir.join("sim");
+    let o = motorcal(&[
+        "simulate",
+        "--input",
+        input.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let rec = read_recording(&out.join("recording.csv"), &ChannelMap::default()).unwrap();
+    assert_eq!(rec.n_samples(), 200);
+    assert_eq!(rec.time[0], 1e-3);
+    let u = rec.voltage.as_ref().expect("the recording carries U");
+    assert_eq!((u[0], u[119], u[120]), (12.0, 12.0, -6.0));
+    // After the reversal the current turns negative: the file's input drove the motor.
+    let current = rec.channel("I").unwrap();
+    assert!(current[60] > 20.0 && current[125] < -20.0, "{current:?}");
+}
+
+#[test]
+fn a_profile_name_still_works_and_a_bad_file_writes_nothing() {
+    let dir = scratch("bad");
+    let out = dir.join("sim");
+    let o = motorcal(&[
+        "simulate",
+        "--input",
+        "step",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let before = std::fs::read(out.join("recording.csv")).unwrap();
+
+    let bad = dir.join("bad.csv");
+    std::fs::write(&bad, "t,U\n0.001,24\n0.002,x\n").unwrap();
+    let o = motorcal(&[
+        "simulate",
+        "--input",
+        bad.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    one_error_line(&o, &["bad.csv:3", "U"]);
+
+    let no_u = dir.join("no_u.csv");
+    std::fs::write(&no_u, "t,V\n0.001,24\n0.002,3\n").unwrap();
+    let o = motorcal(&[
+        "simulate",
+        "--input",
+        no_u.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    one_error_line(&o, &["no_u.csv", "U"]);
+
+    let o = motorcal(&[
+        "simulate",
+        "--input",
+        "reversl",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    one_error_line(&o, &["reversl"]);
+
+    let good = dir.join("good.csv");
+    std::fs::write(&good, "t,U\n0.001,24\n0.002,3\n").unwrap();
+    let o = motorcal(&[
+        "simulate",
+        "--input",
+        good.to_str().unwrap(),
+        "--samples",
+        "10",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    one_error_line(&o, &["--samples"]);
+    assert_eq!(std::fs::read(out.join("recording.csv")).unwrap(), before);
+}
