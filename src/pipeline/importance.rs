@@ -3,7 +3,9 @@
 
 use std::time::Instant;
 
-use super::{Error, Fittable, PhaseCost, RunOutput, RunSettings, SamplerKind, finish_run};
+use super::{
+    Error, Fittable, MetricAdaptation, PhaseCost, RunOutput, RunSettings, SamplerKind, finish_run,
+};
 use crate::density::DensityError;
 use crate::diagnostics::KHAT_UNRELIABLE;
 use crate::optimize::MapEstimate;
@@ -18,8 +20,8 @@ pub const IS_SHAPE: (f64, f64) = (30.0, 1.0);
 
 /// Importance sampling of `posterior` from the Student-t at `map`: `chains × draws` proposals,
 /// resampled. Its `min_ess_bulk` is the smaller of the smoothed weights' ESS and the resampled
-/// draws' bulk ESS. When k̂ > 0.7 (or cannot be fitted) and `settings.fallback`, NUTS with the
-/// dense Laplace metric runs instead; its record keeps k̂, says `fell_back`, and counts the
+/// draws' bulk ESS. When k̂ > 0.7 (or cannot be fitted) and `settings.fallback`, NUTS with a
+/// dense metric tuned in Stan's windows runs instead; its record keeps k̂, says `fell_back`, and counts the
 /// importance sampling it replaced in its warm-up.
 pub(super) fn laplace_is<P: Fittable>(
     posterior: &P,
@@ -60,12 +62,15 @@ pub(super) fn laplace_is<P: Fittable>(
     if khat <= KHAT_UNRELIABLE || !settings.fallback {
         return Ok(output);
     }
+    // The Laplace covariance k̂ just rejected is no metric to trust either: NUTS re-estimates
+    // it in Stan's windows, with their warm-up.
     let nuts = RunSettings {
         sampler: SamplerKind::NutsDense,
         chain: crate::sampler::ChainSettings {
-            warmup: super::default_warmup(SamplerKind::NutsDense, settings.metric_adaptation),
+            warmup: super::default_warmup(SamplerKind::NutsDense, MetricAdaptation::Windows),
             ..settings.chain.clone()
         },
+        metric_adaptation: MetricAdaptation::Windows,
         ..settings.clone()
     };
     let mut posterior = posterior.clone();

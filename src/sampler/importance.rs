@@ -229,6 +229,23 @@ mod tests {
     }
 
     #[test]
+    fn a_banana_is_flagged_by_khat_from_its_laplace_approximation() {
+        use crate::sampler::targets::Banana;
+        for (bend, flagged) in [(0.0, false), (2.0, true)] {
+            let target = Banana { bend, width: 0.3 };
+            // The mode (0, −b) and the Hessian there, diag(1, 1/s²).
+            let precision =
+                DMatrix::from_diagonal(&nalgebra::DVector::from_vec(vec![1.0, 1.0 / 0.09]));
+            let proposal = LaplaceProposal::new(&[0.0, -bend], &precision)
+                .unwrap()
+                .with_shape(30.0, 1.0)
+                .unwrap();
+            let run = importance_sample(&proposal, 4, 1000, 5, |_| Ok(target.clone())).unwrap();
+            assert_eq!(run.khat() > 0.7, flagged, "b = {bend}: k̂ = {}", run.khat());
+        }
+    }
+
+    #[test]
     fn the_draws_do_not_depend_on_the_thread_count() {
         let target = Gaussian::correlated(3, 0.5, 10.0);
         let precision = target.covariance.clone().try_inverse().unwrap();

@@ -133,3 +133,72 @@ pub fn check_gaussian_moments(
     }
     Ok((worst_mean, worst_var))
 }
+
+/// A banana (Haario et al. 1999, twisted Gaussian): x₁ ~ N(0, 1), x₂ | x₁ ~ N(b(x₁² − 1), s²).
+/// Its mode is (0, −b) with Hessian diag(1, 1/s²), so the Laplace approximation there has
+/// var x₂ = s² where the target's is s² + 2b²: a poor approximation that importance sampling's
+/// k̂ must flag. Known moments: E x = (0, 0), var x₁ = 1.
+#[derive(Clone, Debug)]
+pub struct Banana {
+    pub bend: f64,
+    pub width: f64,
+}
+
+impl Banana {
+    /// The two residuals r = (x₁, (x₂ − b(x₁² − 1))/s), log π = −½|r|² (up to a constant),
+    /// and their Jacobian.
+    fn residuals(&self, x: &[f64]) -> ([f64; 2], [[f64; 2]; 2]) {
+        let r2 = (x[1] - self.bend * (x[0] * x[0] - 1.0)) / self.width;
+        let j = [
+            [1.0, 0.0],
+            [-2.0 * self.bend * x[0] / self.width, 1.0 / self.width],
+        ];
+        ([x[0], r2], j)
+    }
+}
+
+impl LogDensity for Banana {
+    fn dim(&self) -> usize {
+        2
+    }
+
+    fn parameter_names(&self) -> Vec<String> {
+        vec!["x.1".into(), "x.2".into()]
+    }
+
+    fn log_density(&mut self, x: &[f64]) -> Result<f64, DensityError> {
+        let (r, _) = self.residuals(x);
+        Ok(-0.5 * (r[0] * r[0] + r[1] * r[1]))
+    }
+
+    fn log_density_and_gradient(
+        &mut self,
+        x: &[f64],
+        grad: &mut [f64],
+    ) -> Result<f64, DensityError> {
+        let (r, j) = self.residuals(x);
+        for (k, g) in grad.iter_mut().enumerate() {
+            *g = -(r[0] * j[0][k] + r[1] * j[1][k]);
+        }
+        Ok(-0.5 * (r[0] * r[0] + r[1] * r[1]))
+    }
+}
+
+/// Gauss–Newton: JᵀJ of the residuals, the exact Hessian at the mode.
+impl FisherMetric for Banana {
+    fn fisher_metric(&mut self, x: &[f64], metric: &mut DMatrix<f64>) -> Result<(), DensityError> {
+        let (_, j) = self.residuals(x);
+        for a in 0..2 {
+            for b in 0..2 {
+                metric[(a, b)] = j[0][a] * j[0][b] + j[1][a] * j[1][b];
+            }
+        }
+        Ok(())
+    }
+}
+
+impl crate::density::StartingPoint for Banana {
+    fn initial_point(&mut self) -> Result<Vec<f64>, DensityError> {
+        Ok(vec![0.3, 0.0])
+    }
+}
