@@ -2,7 +2,7 @@
 //! use): the stop flag ends the chains with `STOPPED`, and keeping the warm-up's draws changes
 //! no draw.
 
-use std::sync::atomic::AtomicBool;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use motorcal::density::DensityError;
 use motorcal::sampler::adapt::{DualAveragingSettings, StepSizeAdaptation};
@@ -46,7 +46,7 @@ fn a_set_stop_flag_ends_the_run() {
     let stop = AtomicBool::new(true);
     let err = nuts(RunControl {
         stop: Some(&stop),
-        save_warmup: false,
+        ..RunControl::default()
     })
     .unwrap_err();
     assert_eq!(err.message, STOPPED);
@@ -57,11 +57,18 @@ fn a_set_stop_flag_ends_the_run() {
 fn keeping_the_warmup_changes_no_draw() {
     let unset = AtomicBool::new(false);
     let plain = nuts(RunControl::default()).unwrap();
+    let transitions = AtomicUsize::new(0);
     let kept = nuts(RunControl {
         stop: Some(&unset),
         save_warmup: true,
+        transitions: Some(&transitions),
     })
     .unwrap();
+    // Every chain's every transition counted, for a caller's progress display.
+    assert_eq!(
+        transitions.load(Ordering::Relaxed),
+        kept.len() * (WARMUP + kept[0].draws.len())
+    );
     for (a, b) in plain.iter().zip(&kept) {
         assert_eq!(a.draws, b.draws);
         assert_eq!(a.records, b.records);

@@ -3,6 +3,8 @@
 //! released and stop on Ctrl-C. The Python side wraps the arrays into `InferenceData`.
 
 use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::atomic::AtomicUsize;
 
 use motorcal::density::LogDensity;
 use motorcal::error::Error;
@@ -17,7 +19,7 @@ use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::background::interruptible;
+use crate::background::{Progress, interruptible_with};
 use crate::data::Model;
 use crate::posterior::{Calibration, Posterior, Recordings};
 use crate::{py_error, to_python};
@@ -128,7 +130,7 @@ fn cube<'py>(
 /// Runs the fit; returns a dict of NumPy arrays and the fit's figures (see
 /// `motorcal.fit`).
 #[pyfunction]
-#[pyo3(signature = (recordings, model, bm=None, k=None, sampler="nuts-dense", chains=4, warmup=None, draws=1000, keep=None, seed=motorcal::synthetic::DEFAULT_SEED, threads=None, metric_adaptation=None, prior_family="laplace", prior_decay=0.0, force=false, out=None, save_warmup=true, posterior_predictive=true))]
+#[pyo3(signature = (recordings, model, bm=None, k=None, sampler="nuts-dense", chains=4, warmup=None, draws=1000, keep=None, seed=motorcal::synthetic::DEFAULT_SEED, threads=None, metric_adaptation=None, prior_family="laplace", prior_decay=0.0, force=false, out=None, save_warmup=true, posterior_predictive=true, show_progress=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn fit_raw<'py>(
     py: Python<'py>,
@@ -150,6 +152,7 @@ pub fn fit_raw<'py>(
     out: Option<PathBuf>,
     save_warmup: bool,
     posterior_predictive: bool,
+    show_progress: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let calibration = Calibration {
         bm,
@@ -170,7 +173,14 @@ pub fn fit_raw<'py>(
     )
     .map_err(py_error)?;
     settings.save_warmup = save_warmup;
-    let (fitted, replicated) = interruptible(py, |stop| {
+    let transitions = Arc::new(AtomicUsize::new(0));
+    settings.transitions = Some(transitions.clone());
+    let progress = show_progress.then(|| Progress {
+        label: format!("fit {}", settings.sampler.name()),
+        done: transitions,
+        total: settings.chains * (settings.chain.warmup + settings.chain.draws),
+    });
+    let (fitted, replicated) = interruptible_with(py, progress.as_ref(), |stop| {
         settings.stop = Some(stop);
         let fitted = fit_work(&recordings, &model, &calibration, &settings, out.as_ref())?;
         // Replicated recordings from the kept draws, while the GIL is still released.

@@ -131,3 +131,13 @@ def test_the_posterior_predictive_scatters_about_the_fit_by_its_noise(py_fit):
         sigma = py_fit.posterior[f"sigma_{name}"].values.mean()
         spread = values.reshape(-1, n).std(axis=0).mean()
         assert 0.9 * sigma < spread < 1.2 * sigma, (name, spread, sigma)
+
+
+def test_progress_is_one_line_redrawn_and_ended_at_the_total(recording, model, capfd):
+    motorcal.fit(recording, model, bm=1, chains=2, draws=300, seed=5, progress=True)
+    err = capfd.readouterr().err
+    # Each redraw starts with a carriage return; the last one says every transition is done.
+    assert err.endswith("\n") and err.count("\n") == 1
+    last = err.rstrip("\n").split("\r")[-1]
+    total = 2 * (100 + 300)
+    assert last.endswith(f"{total}/{total} transitions"), last

@@ -173,6 +173,7 @@ where
             RunControl {
                 stop: settings.stop.as_deref(),
                 save_warmup: settings.save_warmup,
+                transitions: settings.transitions.as_deref(),
             },
         )
     };

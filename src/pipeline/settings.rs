@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 use std::sync::Arc;
-use std::sync::atomic::AtomicBool;
+use std::sync::atomic::{AtomicBool, AtomicUsize};
 
 use serde::{Deserialize, Serialize};
 
@@ -189,6 +189,9 @@ pub struct RunSettings {
     /// Keep every warm-up draw in the chains' output too (the draws are the same either way).
     #[serde(skip)]
     pub save_warmup: bool,
+    /// Counts every chain's transitions for a caller's progress display; changes no draw.
+    #[serde(skip)]
+    pub transitions: Option<Arc<AtomicUsize>>,
     /// laplace-is: run NUTS (dense) on the same problem instead when k̂ says the Laplace
     /// approximation cannot be trusted.
     pub fallback: bool,
@@ -209,6 +212,7 @@ impl Default for RunSettings {
             metric_adaptation: MetricAdaptation::default(),
             stop: None,
             save_warmup: false,
+            transitions: None,
             fallback: true,
         }
     }

@@ -1,7 +1,7 @@
 //! The driver: warm-up then sampling for any kernel and adaptation, one chain or several in
 //! parallel, with per-chain random streams so that draws do not depend on the thread count.
 
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
 use indicatif::ProgressBar;
@@ -162,6 +162,9 @@ pub struct RunControl<'a> {
     pub stop: Option<&'a AtomicBool>,
     /// Keep every warm-up draw in [`ChainOutput::warmup_draws`] and `warmup_records`.
     pub save_warmup: bool,
+    /// Counts every chain's transitions, warm-up and sampling, for a caller's own progress
+    /// display (the Python bindings draw theirs from it).
+    pub transitions: Option<&'a AtomicUsize>,
 }
 
 /// One chain's place in a run.
@@ -225,6 +228,9 @@ where
         }
         adaptation.observe(&mut kernel, &state, &info, iteration, settings.warmup);
         reporter.tick(iteration, &info, divergences_warmup, "warm-up");
+        if let Some(count) = control.transitions {
+            count.fetch_add(1, Ordering::Relaxed);
+        }
     }
     adaptation.finish(&mut kernel);
     let warmup = PhaseCost::counted(warmup_watch.elapsed(), &density);
@@ -250,6 +256,9 @@ where
             records.push(DrawRecord::of(&state, &info));
         }
         reporter.tick(settings.warmup + i, &info, divergences, "sampling");
+        if let Some(count) = control.transitions {
+            count.fetch_add(1, Ordering::Relaxed);
+        }
     }
     let sampling = PhaseCost::counted(sampling_watch.elapsed(), &density).after(&warmup);
     reporter.finish(divergences);

@@ -15,6 +15,8 @@ No progress bars are drawn from Python.
 
 from __future__ import annotations
 
+import sys
+
 from . import _motorcal
 from ._motorcal import (
     DEFAULT_SEED,
@@ -108,6 +110,7 @@ def fit(
     out=None,
     save_warmup=True,
     posterior_predictive=True,
+    progress=True,
     inference_data=None,
 ):
     """Calibrate ``model`` on ``recordings`` (one or a list) as ``motorcal fit`` does: the MAP
@@ -117,6 +120,9 @@ def fit(
     to the sampler's (100 for HMC/NUTS on the Laplace metric, else 1000). With ``out`` the
     draws are also written there as CmdStan CSV (``fit-<sampler>-chain<N>.csv``), after the run:
     an interrupted fit writes nothing.
+
+    With ``progress`` a one-line bar on standard error counts the chains' transitions, redrawn
+    in place (a terminal and a notebook's output cell alike).
 
     With ``posterior_predictive`` every kept draw also gives a replicated recording,
     G(θ) + δ + σ·ε (one solve a draw, the noise from ``seed``): the ``posterior_predictive``
@@ -149,6 +155,7 @@ def fit(
         out=None if out is None else str(out),
         save_warmup=save_warmup,
         posterior_predictive=posterior_predictive,
+        show_progress=bool(progress),
     )
     names = raw["names"]
     posterior = {name: raw["draws"][:, :, j] for j, name in enumerate(names)}
@@ -184,6 +191,16 @@ def fit(
         result["warmup_sample_stats"] = warmup["sample_stats"]
     result.update(figures)
     return result
+
+
+def _progress(label, done, total):
+    """One line of progress on standard error, rewritten in place; ended when done."""
+    width = 30
+    filled = width * done // max(total, 1)
+    bar = "#" * filled + "-" * (width - filled)
+    end = "\n" if done >= total else ""
+    sys.stderr.write(f"\r{label} [{bar}] {done}/{total} transitions{end}")
+    sys.stderr.flush()
 
 
 def _typed(stats):
