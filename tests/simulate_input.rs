@@ -120,3 +120,22 @@ fn a_profile_name_still_works_and_a_bad_file_writes_nothing() {
     one_error_line(&o, &["--samples"]);
     assert_eq!(std::fs::read(out.join("recording.csv")).unwrap(), before);
 }
+
+/// A drive base measures other channels than I and ω (HSM150's current-driven base measures ω
+/// alone): the noise line names the model's own, where it used to index a second channel.
+#[test]
+fn a_drive_base_truth_is_simulated_and_its_channels_named() {
+    let dir = scratch("drive-base");
+    let truth = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/hsm150/model.toml");
+    let o = motorcal(&["simulate", "--truth", truth, "--out", dir.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    let out = String::from_utf8_lossy(&o.stdout);
+    let line = out
+        .lines()
+        .find(|l| l.starts_with("realised noise sd:"))
+        .expect("the noise line");
+    assert!(line.contains("omega") && !line.contains(','), "{line}");
+    assert!(dir.join("recording.csv").exists());
+}

@@ -157,9 +157,17 @@ pub fn run(options: &SimulateOptions) -> Result<(), AppError> {
         "wrote {} (the truth that made the data)",
         report.truth.display()
     );
+    // One entry per measured channel: a drive base measures other channels than I and ω.
+    let sds: Vec<String> = report
+        .channels
+        .iter()
+        .zip(&report.realised_noise_sd)
+        .map(|(name, sd)| format!("{name} {sd:.4}"))
+        .collect();
     println!(
-        "realised noise sd: I {:.4} A, omega {:.4} rad/s (seed {})",
-        report.realised_noise_sd[0], report.realised_noise_sd[1], options.seed
+        "realised noise sd: {} (seed {})",
+        sds.join(", "),
+        options.seed
     );
     Ok(())
 }
@@ -171,6 +179,8 @@ pub struct SimulateReport {
     pub nominal: PathBuf,
     pub truth: PathBuf,
     pub realised_noise_sd: Vec<f64>,
+    /// The measured channels, in the order of `realised_noise_sd`.
+    pub channels: Vec<String>,
 }
 
 pub fn simulate(options: &SimulateOptions) -> Result<SimulateReport, AppError> {
@@ -246,6 +256,7 @@ pub fn simulate(options: &SimulateOptions) -> Result<SimulateReport, AppError> {
         nominal: options.out.join("motor.toml"),
         truth: options.out.join("truth.toml"),
         realised_noise_sd: data.realised_noise_sd(),
+        channels: data.channel_names.clone(),
     };
     write_recording(&report.recording, &recording)?;
     write_model_file(&report.nominal, &nominal_file)?;
