@@ -97,13 +97,19 @@ def test_without_arviz_a_dict_of_arrays(recording, model):
 
 def test_an_interrupted_fit_raises_and_writes_nothing(recording, model, tmp_path):
     out = tmp_path / "interrupted"
+    # Python leaves SIGINT ignored when it started ignored (a background job of a
+    # non-interactive shell, as CI may run us): install the default handler for this test.
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
     timer = threading.Timer(1.0, lambda: os.kill(os.getpid(), signal.SIGINT))
     timer.start()
     try:
         with pytest.raises(KeyboardInterrupt):
-            motorcal.fit(recording, model, k=3, chains=2, draws=500_000, seed=1, out=out)
+            motorcal.fit(
+                recording, model, k=3, chains=2, draws=500_000, seed=1, out=out, progress=False
+            )
     finally:
         timer.cancel()
+        signal.signal(signal.SIGINT, previous)
     assert not out.exists() or not any(out.iterdir())
 
 
