@@ -126,12 +126,12 @@ pub fn sample(
     Ok(SampledFit { posterior, run })
 }
 
-/// `laplace-is` with `run`'s chains × draws proposals; kept where k̂ < 0.5, the bound below
+/// `laplace-is` with `run`'s chains × draws proposals, kept where k̂ ≤ 0.5, the bound below
 /// which Pareto-smoothed importance sampling converges at the Monte Carlo rate (Vehtari et al.,
-/// "Pareto smoothed importance sampling"), otherwise `run`'s own sampler on the same problem,
-/// recording the k̂ that sent it there. The calibration posteriors are close to Gaussian in
-/// their unconstrained coordinates, so most fits stay on the importance path: one plain solve
-/// per proposal against a dual-number solve per leapfrog step.
+/// "Pareto smoothed importance sampling"); above it, laplace-is's own fallback (NUTS on the
+/// same problem, the k̂ kept). The calibration posteriors are close to Gaussian in their
+/// unconstrained coordinates, so most fits stay on the importance path: one plain solve per
+/// proposal against a dual-number solve per leapfrog step.
 fn importance_or_sampler(
     posterior: &mut CalibrationPosterior,
     run: &RunSettings,
@@ -139,18 +139,11 @@ fn importance_or_sampler(
 ) -> Result<RunOutput, Error> {
     let importance = RunSettings {
         sampler: SamplerKind::LaplaceIs,
-        fallback: false,
+        fallback: true,
+        fallback_above: KHAT_GOOD,
         ..run.clone()
     };
-    let tried = run_sampler(posterior, &importance, label)?;
-    match tried.khat {
-        Some(khat) if khat < KHAT_GOOD => Ok(tried),
-        khat => Ok(RunOutput {
-            khat,
-            fell_back: true,
-            ..run_sampler(posterior, run, label)?
-        }),
-    }
+    run_sampler(posterior, &importance, label)
 }
 
 /// x = MAP + L⁻ᵀ z with z ~ N(0, I) and L Lᵀ the Hessian at the MAP (the Gaussian form of

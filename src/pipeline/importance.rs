@@ -7,7 +7,6 @@ use super::{
     Error, Fittable, MetricAdaptation, PhaseCost, RunOutput, RunSettings, SamplerKind, finish_run,
 };
 use crate::density::DensityError;
-use crate::diagnostics::KHAT_UNRELIABLE;
 use crate::optimize::MapEstimate;
 use crate::sampler::importance::{NAME, importance_sample};
 use crate::sampler::proposal::LaplaceProposal;
@@ -20,7 +19,7 @@ pub const IS_SHAPE: (f64, f64) = (30.0, 1.0);
 
 /// Importance sampling of `posterior` from the Student-t at `map`: `chains × draws` proposals,
 /// resampled. Its `min_ess_bulk` is the smaller of the smoothed weights' ESS and the resampled
-/// draws' bulk ESS. When k̂ > 0.7 (or cannot be fitted) and `settings.fallback`, NUTS with a
+/// draws' bulk ESS. When k̂ > `settings.fallback_above` (0.7 by default; or cannot be fitted) and `settings.fallback`, NUTS with a
 /// dense metric tuned in Stan's windows runs instead; its record keeps k̂, says `fell_back`, and counts the
 /// importance sampling it replaced in its warm-up.
 pub(super) fn laplace_is<P: Fittable>(
@@ -43,14 +42,7 @@ pub(super) fn laplace_is<P: Fittable>(
             |_| Ok::<_, DensityError>(posterior.clone()),
         )
     };
-    let run = match settings.threads {
-        Some(n) => rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build()
-            .map_err(|e| Error::setting("threads", n, e.to_string()))?
-            .install(work),
-        None => work(),
-    }?;
+    let run = super::in_pool(settings.threads, work)??;
     let khat = run.khat();
     let weights_ess = run.weights_ess();
     let mut output = RunOutput {
@@ -59,7 +51,7 @@ pub(super) fn laplace_is<P: Fittable>(
         ..finish_run(NAME, run.chains, map, started)
     };
     output.min_ess_bulk = output.min_ess_bulk.min(weights_ess);
-    if khat <= KHAT_UNRELIABLE || !settings.fallback {
+    if khat <= settings.fallback_above || !settings.fallback {
         return Ok(output);
     }
     // The Laplace covariance k̂ just rejected is no metric to trust either: NUTS re-estimates

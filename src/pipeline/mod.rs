@@ -177,15 +177,19 @@ where
             },
         )
     };
-    let result = match settings.threads {
-        Some(n) => rayon::ThreadPoolBuilder::new()
+    Ok(in_pool(settings.threads, work)??)
+}
+
+/// `work` on a pool of `threads` (rayon's global pool when `None`).
+fn in_pool<T: Send>(threads: Option<usize>, work: impl FnOnce() -> T + Send) -> Result<T, Error> {
+    match threads {
+        Some(n) => Ok(rayon::ThreadPoolBuilder::new()
             .num_threads(n)
             .build()
             .map_err(|e| Error::setting("threads", n, e.to_string()))?
-            .install(work),
-        None => work(),
-    };
-    Ok(result?)
+            .install(work)),
+        None => Ok(work()),
+    }
 }
 
 /// Diagnostics of every reported quantity over all chains.

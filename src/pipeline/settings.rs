@@ -195,6 +195,10 @@ pub struct RunSettings {
     /// laplace-is: run NUTS (dense) on the same problem instead when k̂ says the Laplace
     /// approximation cannot be trusted.
     pub fallback: bool,
+    /// laplace-is: the k̂ above which it falls back (0.7, where PSIS stops being reliable, by
+    /// default; a diagnosis's fits ask for 0.5, below which its estimates converge at the
+    /// Monte Carlo rate).
+    pub fallback_above: f64,
 }
 
 impl Default for RunSettings {
@@ -214,6 +218,7 @@ impl Default for RunSettings {
             save_warmup: false,
             transitions: None,
             fallback: true,
+            fallback_above: crate::diagnostics::KHAT_UNRELIABLE,
         }
     }
 }
