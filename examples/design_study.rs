@@ -215,6 +215,12 @@ fn pin(records: usize) -> Result<(), Box<dyn std::error::Error>> {
             predicted.sd["R"], predicted.sd["c_g/J"], r, ratio
         );
     }
+    let fixed = &d.fixed_experiments[0].1;
+    println!(
+        "  the constant 24 V's predicted sd over the designed input's: R {:.2}, c_g/J {:.2}",
+        fixed.sd["R"] / d.pinned.sd["R"],
+        fixed.sd["c_g/J"] / d.pinned.sd["c_g/J"]
+    );
     Ok(())
 }
 
