@@ -12,7 +12,9 @@ use crate::density::LogDensity;
 use crate::diagnostics::{KHAT_GOOD, autocovariance};
 use crate::error::Error;
 use crate::optimize::{MapSettings, find_map};
-use crate::pipeline::{RunOutput, RunSettings, SamplerKind, finish_run, run_sampler};
+use crate::pipeline::{
+    RunOutput, RunSettings, SamplerKind, default_warmup, finish_run, run_sampler,
+};
 use crate::sampler::driver::chain_rng;
 use crate::sampler::proposal::LaplaceProposal;
 use crate::sampler::{ChainOutput, DrawRecord, PhaseCost};
@@ -141,6 +143,11 @@ fn importance_or_sampler(
         sampler: SamplerKind::LaplaceIs,
         fallback: true,
         fallback_above: KHAT_GOOD,
+        // The run's warm-up is NUTS's; importance sampling's is its own recentring.
+        chain: crate::sampler::ChainSettings {
+            warmup: default_warmup(SamplerKind::LaplaceIs, run.metric_adaptation),
+            ..run.chain.clone()
+        },
         ..run.clone()
     };
     run_sampler(posterior, &importance, label)

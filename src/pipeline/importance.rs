@@ -37,6 +37,7 @@ pub(super) fn laplace_is<P: Fittable>(
         importance_sample(
             &proposal,
             settings.chains,
+            settings.chain.warmup,
             settings.chain.draws,
             settings.seed,
             |_| Ok::<_, DensityError>(posterior.clone()),
@@ -71,7 +72,7 @@ pub(super) fn laplace_is<P: Fittable>(
         khat: Some(khat),
         fell_back: true,
         map: output.map + fallback.map,
-        warmup: output.sampling + fallback.warmup,
+        warmup: output.warmup + output.sampling + fallback.warmup,
         wall_seconds: started.elapsed().as_secs_f64(),
         ..fallback
     })

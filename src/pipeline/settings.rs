@@ -121,11 +121,13 @@ pub enum MetricAdaptation {
 /// (t₀ = 10) ten times its damping span to settle, for posteriors less Gaussian than the
 /// paper's, at a tenth of 1000 draws. Everything else keeps Stan's 1000: the windows need it
 /// to estimate a metric, and MALA's step-size search is noisier. The independence sampler
-/// tries each of its proposal shapes for 40 transitions; importance sampling has no warm-up.
+/// tries each of its proposal shapes for 40 transitions; importance sampling spends a quarter of
+/// its default 1000 draws per chain recentring its proposal (`sampler::importance`), and those
+/// draws are weighed into the result, not discarded.
 pub fn default_warmup(sampler: SamplerKind, metric: MetricAdaptation) -> usize {
     match sampler {
         SamplerKind::Independence => crate::sampler::independence::INDEPENDENCE_WARMUP,
-        SamplerKind::LaplaceIs => 0,
+        SamplerKind::LaplaceIs => crate::sampler::importance::IS_WARMUP,
         _ if sampler.is_hamiltonian() && metric == MetricAdaptation::Laplace => LAPLACE_WARMUP,
         _ => 1000,
     }

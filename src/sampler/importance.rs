@@ -5,11 +5,25 @@
 //! 2024); the smoothed weights' effective sample size says how many independent draws they are
 //! worth — the resampled draws look independent and would overstate it.
 //!
+//! The MAP is the joint posterior's mode, not its mean: with many coefficients beside them the
+//! noise scales' marginal sits above their joint mode (at K = 20 on the paper's data the weighted
+//! mean of log σ lies 0.7 Laplace standard deviations above the MAP), and a proposal off centre
+//! by δ in whitened units loses about a factor e^{-|δ|²} of its effective draws. So the
+//! warm-up recentres the proposal in rounds: each round's draws are weighed, the weighted mean
+//! is taken in whitened coordinates, and only the coordinates whose shift exceeds twice its
+//! Monte Carlo standard error move (in 45 dimensions, moving every coordinate by its noise costs
+//! more than the shift gains). The scale matrix stays the Laplace one: a covariance estimated
+//! from a few hundred effective draws in 45 dimensions is mostly noise (Marchenko–Pastur).
+//! Nothing is thrown away: every round's draws are weighed against the mixture of all rounds'
+//! proposals (the balance heuristic of multiple importance sampling, Veach & Guibas 1995; Owen
+//! & Zhou 2000), and all of them enter the smoothing and the resampling.
+//!
 //! The proposals are made in `chains` parallel blocks, each on its chain's random stream, so the
 //! draws do not depend on the thread count; the weights are smoothed together, and the
 //! resampling (systematic, then shuffled and dealt back into `chains` blocks) runs on a stream
 //! of its own.
 
+use nalgebra::DVector;
 use rand::RngExt;
 use rayon::prelude::*;
 
@@ -29,8 +43,11 @@ pub struct ImportanceRun {
     /// The resampled, equal-weight draws in `chains` blocks; each record's `weight` is the
     /// smoothed normalised weight of the proposal it copies.
     pub chains: Vec<ChainOutput>,
-    /// The smoothed weights of all proposals, in proposal order (chain by chain).
+    /// The smoothed weights of all proposals, warm-up rounds' included, in proposal order
+    /// (round by round, chain by chain within a round).
     pub psis: Psis,
+    /// The final proposal's centre: the MAP moved by the recentring rounds.
+    pub centre: Vec<f64>,
 }
 
 impl ImportanceRun {
@@ -44,19 +61,29 @@ impl ImportanceRun {
     }
 }
 
-/// One block of proposals: the points, their log densities and log weights, and its cost.
+/// One block of proposals: the points, their log densities, and its cost.
 struct Block {
     x: Vec<Vec<f64>>,
     log_density: Vec<f64>,
-    log_weights: Vec<f64>,
     cost: PhaseCost,
 }
 
-/// `chains × draws` proposals from `proposal` on the densities `make` builds (one per block,
-/// so caches are never shared), Pareto-smoothed and resampled.
+/// Rounds the warm-up's proposals are spread over. The first moves the centre most of the way
+/// from a sample weighed against the MAP's proposal; the second re-estimates it from draws
+/// already near the new centre, whose weights are less uneven.
+pub const RECENTRING_ROUNDS: usize = 2;
+
+/// Proposals per chain spent recentring when no warm-up is given (see `default_warmup`).
+pub const IS_WARMUP: usize = 250;
+
+/// `warmup` proposals per chain spent recentring (in [`RECENTRING_ROUNDS`] rounds; 0 keeps the
+/// MAP), then `draws` per chain from the recentred `proposal`, on the densities `make` builds
+/// (one per block, so caches are never shared); all of them Pareto-smoothed together and
+/// resampled to `chains × draws` equal-weight draws.
 pub fn importance_sample<P, F>(
     proposal: &LaplaceProposal,
     chains: usize,
+    warmup: usize,
     draws: usize,
     seed: u64,
     make: F,
@@ -68,16 +95,43 @@ where
     if chains == 0 || draws == 0 {
         return Err(DensityError::fatal("importance sampling needs draws"));
     }
-    let blocks: Vec<Block> = (0..chains)
-        .into_par_iter()
-        .map(|c| propose(proposal, make(c)?, draws, &mut chain_rng(seed, c)))
-        .collect::<Result<_, _>>()?;
+    let mut rngs: Vec<_> = (0..chains).map(|c| chain_rng(seed, c)).collect();
+    let per_round = if warmup >= RECENTRING_ROUNDS {
+        vec![warmup / RECENTRING_ROUNDS; RECENTRING_ROUNDS]
+    } else {
+        Vec::new()
+    };
+    let mut components: Vec<(LaplaceProposal, usize)> = Vec::new();
+    let mut rounds: Vec<Vec<Block>> = Vec::new();
+    let mut current = proposal.clone();
+    for n in per_round.iter().copied().chain([draws]) {
+        let blocks: Vec<Block> = rngs
+            .par_iter_mut()
+            .enumerate()
+            .map(|(c, rng)| propose(&current, make(c)?, n, rng))
+            .collect::<Result<_, _>>()?;
+        components.push((current.clone(), n * chains));
+        rounds.push(blocks);
+        if rounds.len() <= per_round.len() {
+            let smoothed = psis(&log_weights(&rounds, &components));
+            current = recentre(&current, &rounds, &smoothed);
+        }
+    }
     let watch = Stopwatch::start();
-    let log_weights: Vec<f64> = blocks.iter().flat_map(|b| b.log_weights.clone()).collect();
-    let smoothed = psis(&log_weights);
-    let picks = resample(&smoothed.weights(), &mut chain_rng(seed, chains));
+    let smoothed = psis(&log_weights(&rounds, &components));
+    let pool: Vec<(&Vec<f64>, f64)> = rounds
+        .iter()
+        .flatten()
+        .flat_map(|b| b.x.iter().zip(b.log_density.iter().copied()))
+        .collect();
+    let picks = resample(
+        &smoothed.weights(),
+        chains * draws,
+        &mut chain_rng(seed, chains),
+    );
     let density = make(0)?;
     let names = density.output_names();
+    let finals = rounds.last().expect("the final round");
     let mut outputs = picks
         .chunks(draws)
         .enumerate()
@@ -89,8 +143,8 @@ where
                 draws: Vec::with_capacity(draws),
                 unconstrained: Vec::with_capacity(draws),
                 records: Vec::with_capacity(draws),
-                warmup: PhaseCost::default(),
-                sampling: blocks[c].cost,
+                warmup: rounds[..rounds.len() - 1].iter().map(|r| r[c].cost).sum(),
+                sampling: finals[c].cost,
                 uses_gradient: false,
                 divergences: 0,
                 mean_accept_stat: 1.0,
@@ -100,12 +154,10 @@ where
             };
             let mut constrained = Vec::new();
             for &i in picks {
-                let (b, j) = (i / draws, i % draws);
-                let x = &blocks[b].x[j];
+                let (x, lp) = pool[i];
                 density.constrain(x, &mut constrained);
                 out.draws.push(constrained.clone());
                 out.unconstrained.push(x.clone());
-                let lp = blocks[b].log_density[j];
                 out.records.push(DrawRecord {
                     lp,
                     accept_stat: 1.0,
@@ -127,7 +179,84 @@ where
     Ok(ImportanceRun {
         chains: outputs,
         psis: smoothed,
+        centre: current.mean().to_vec(),
     })
+}
+
+/// log π(x) − log Σᵣ (nᵣ/N) qᵣ(x) for every proposal so far: each weighed against the mixture of
+/// all rounds' proposals (with one round, exactly log π − log q).
+fn log_weights(rounds: &[Vec<Block>], components: &[(LaplaceProposal, usize)]) -> Vec<f64> {
+    let total: usize = components.iter().map(|c| c.1).sum();
+    let log_shares: Vec<f64> = components
+        .iter()
+        .map(|(_, n)| (*n as f64).ln() - (total as f64).ln())
+        .collect();
+    let points = rounds
+        .iter()
+        .flatten()
+        .flat_map(|b| b.x.iter().zip(&b.log_density));
+    points
+        .map(|(x, &lp)| {
+            if lp == f64::NEG_INFINITY {
+                // Outside the support, or its solve failed: it weighs nothing.
+                return lp;
+            }
+            let terms: Vec<f64> = components
+                .iter()
+                .zip(&log_shares)
+                .map(|((q, _), share)| share + q.log_density(x))
+                .collect();
+            let top = terms.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            let log_mixture = if terms.len() == 1 {
+                terms[0]
+            } else {
+                top + terms.iter().map(|t| (t - top).exp()).sum::<f64>().ln()
+            };
+            lp - log_mixture
+        })
+        .collect()
+}
+
+/// The centre moved to the weighted mean of every proposal so far, in the coordinates that the
+/// Laplace scale matrix whitens, where that shift exceeds twice its Monte Carlo standard error
+/// (√(weighted variance / the weights' ESS)); elsewhere it stays.
+fn recentre(current: &LaplaceProposal, rounds: &[Vec<Block>], smoothed: &Psis) -> LaplaceProposal {
+    let weights = smoothed.weights();
+    let ess = smoothed.ess();
+    let whitened: Vec<DVector<f64>> = rounds
+        .iter()
+        .flatten()
+        .flat_map(|b| b.x.iter())
+        .map(|x| current.whiten(x))
+        .collect();
+    let d = current.dim();
+    let mut mean = DVector::zeros(d);
+    for (z, w) in whitened.iter().zip(&weights) {
+        if *w > 0.0 {
+            mean += z * *w;
+        }
+    }
+    let mut variance = DVector::<f64>::zeros(d);
+    for (z, w) in whitened.iter().zip(&weights) {
+        if *w > 0.0 {
+            let r = z - &mean;
+            variance += r.component_mul(&r) * *w;
+        }
+    }
+    if !(ess > 1.0) || !mean.iter().all(|m| m.is_finite()) {
+        return current.clone();
+    }
+    let shift = DVector::from_iterator(
+        d,
+        mean.iter().zip(variance.iter()).map(|(m, v)| {
+            if m.abs() > 2.0 * (v / ess).sqrt() {
+                *m
+            } else {
+                0.0
+            }
+        }),
+    );
+    current.recentred(&current.unwhiten(&shift))
 }
 
 fn propose<P: LogDensity>(
@@ -141,30 +270,22 @@ fn propose<P: LogDensity>(
     let mut block = Block {
         x: Vec::with_capacity(draws),
         log_density: Vec::with_capacity(draws),
-        log_weights: Vec::with_capacity(draws),
         cost: PhaseCost::default(),
     };
     for _ in 0..draws {
         let x = proposal.draw(rng);
         let lp = proposal_log_density(&mut density, &x)?;
-        // A proposal outside the support (or whose solve failed) weighs nothing.
-        let lw = if lp == f64::NEG_INFINITY {
-            lp
-        } else {
-            lp - proposal.log_density(&x)
-        };
         block.x.push(x);
         block.log_density.push(lp);
-        block.log_weights.push(lw);
     }
     block.cost = PhaseCost::counted(watch.elapsed(), &density);
     Ok(block)
 }
 
-/// Systematic resampling (one uniform, n evenly spaced points through the weights' cumulative
-/// sum), then a Fisher–Yates shuffle so that consecutive draws are not sorted by proposal.
-fn resample(weights: &[f64], rng: &mut super::ChainRng) -> Vec<usize> {
-    let n = weights.len();
+/// Systematic resampling of `n` picks (one uniform, n evenly spaced points through the weights'
+/// cumulative sum), then a Fisher–Yates shuffle so that consecutive draws are not sorted by
+/// proposal.
+fn resample(weights: &[f64], n: usize, rng: &mut super::ChainRng) -> Vec<usize> {
     let total: f64 = weights.iter().sum();
     let u: f64 = rng.random::<f64>();
     let mut picks = Vec::with_capacity(n);
@@ -172,7 +293,7 @@ fn resample(weights: &[f64], rng: &mut super::ChainRng) -> Vec<usize> {
     let mut i = 0;
     for k in 0..n {
         let point = (u + k as f64) / n as f64 * total;
-        while i + 1 < n && cumulative + weights[i] <= point {
+        while i + 1 < weights.len() && cumulative + weights[i] <= point {
             cumulative += weights[i];
             i += 1;
         }
@@ -194,7 +315,7 @@ mod tests {
     #[test]
     fn systematic_resampling_copies_each_draw_in_proportion_to_its_weight() {
         let weights = [0.5, 0.25, 0.125, 0.125, 0.0];
-        let picks = resample(&weights, &mut chain_rng(1, 0));
+        let picks = resample(&weights, weights.len(), &mut chain_rng(1, 0));
         let count = |i| picks.iter().filter(|&&p| p == i).count() as f64;
         // Systematic resampling keeps every count within one of n·wᵢ.
         for (i, w) in weights.iter().enumerate() {
@@ -211,7 +332,7 @@ mod tests {
             .unwrap()
             .with_shape(10.0, 1.2)
             .unwrap();
-        let run = importance_sample(&proposal, 4, 1000, 17, |_| Ok(target.clone())).unwrap();
+        let run = importance_sample(&proposal, 4, 0, 1000, 17, |_| Ok(target.clone())).unwrap();
         assert!(run.khat() < 0.5, "k̂ = {}", run.khat());
         assert!(run.weights_ess() > 2000.0, "ESS {}", run.weights_ess());
         assert_eq!(run.chains.len(), 4);
@@ -221,10 +342,44 @@ mod tests {
     }
 
     #[test]
+    fn recentring_moves_an_off_centre_proposal_onto_the_mean_and_keeps_every_draw() {
+        // The proposal's centre 0.8 standard deviations off in two of eight coordinates, as the
+        // joint mode sits off the noise scales' marginal at K = 20.
+        let target = Gaussian::correlated(8, 0.3, 1.0);
+        let precision = target.covariance.clone().try_inverse().unwrap();
+        let mut mode: Vec<f64> = target.mean.iter().copied().collect();
+        mode[0] -= 0.8 * target.covariance[(0, 0)].sqrt();
+        mode[5] += 0.8 * target.covariance[(5, 5)].sqrt();
+        let proposal = LaplaceProposal::new(&mode, &precision)
+            .unwrap()
+            .with_shape(30.0, 1.0)
+            .unwrap();
+        let fixed = importance_sample(&proposal, 4, 0, 1000, 21, |_| Ok(target.clone())).unwrap();
+        let moved = importance_sample(&proposal, 4, 250, 1000, 21, |_| Ok(target.clone())).unwrap();
+        let miss = |c: &[f64]| {
+            let z = proposal.recentred(target.mean.as_slice()).whiten(c);
+            z.norm()
+        };
+        assert!(miss(&fixed.centre) > 1.0, "{}", miss(&fixed.centre));
+        assert!(miss(&moved.centre) < 0.3, "{}", miss(&moved.centre));
+        // The warm-up's 1000 proposals count too: 5000 weighed, 4000 resampled.
+        assert_eq!(moved.psis.log_weights.len(), 5000);
+        assert!(moved.chains.iter().all(|c| c.draws.len() == 1000));
+        assert_eq!(moved.chains[0].warmup.density_evaluations, 250);
+        assert!(
+            moved.weights_ess() > 1.3 * fixed.weights_ess(),
+            "ESS {} recentred vs {} at the mode",
+            moved.weights_ess(),
+            fixed.weights_ess()
+        );
+        check_gaussian_moments(&moved.chains, &target, 4.0).unwrap();
+    }
+
+    #[test]
     fn a_proposal_too_narrow_is_flagged_by_khat() {
         let target = Gaussian::new(vec![0.0, 0.0], DMatrix::identity(2, 2));
         let proposal = LaplaceProposal::new(&[0.0, 0.0], &(DMatrix::identity(2, 2) * 9.0)).unwrap();
-        let run = importance_sample(&proposal, 2, 2000, 3, |_| Ok(target.clone())).unwrap();
+        let run = importance_sample(&proposal, 2, 0, 2000, 3, |_| Ok(target.clone())).unwrap();
         assert!(run.khat() > 0.7, "k̂ = {}", run.khat());
     }
 
@@ -240,7 +395,7 @@ mod tests {
                 .unwrap()
                 .with_shape(30.0, 1.0)
                 .unwrap();
-            let run = importance_sample(&proposal, 4, 1000, 5, |_| Ok(target.clone())).unwrap();
+            let run = importance_sample(&proposal, 4, 0, 1000, 5, |_| Ok(target.clone())).unwrap();
             assert_eq!(run.khat() > 0.7, flagged, "b = {bend}: k̂ = {}", run.khat());
         }
     }
@@ -256,7 +411,7 @@ mod tests {
                 .num_threads(threads)
                 .build()
                 .unwrap()
-                .install(|| importance_sample(&proposal, 3, 200, 9, |_| Ok(target.clone())))
+                .install(|| importance_sample(&proposal, 3, 0, 200, 9, |_| Ok(target.clone())))
                 .unwrap()
         };
         let (one, two) = (run(1), run(2));

@@ -86,6 +86,34 @@ impl LaplaceProposal {
         self.scale
     }
 
+    /// The centre (the MAP, or where recentring moved it).
+    pub fn mean(&self) -> &[f64] {
+        self.mean.as_slice()
+    }
+
+    /// The same scale matrix and shape centred at `mean`.
+    pub fn recentred(&self, mean: &[f64]) -> Self {
+        Self {
+            mean: DVector::from_column_slice(mean),
+            ..self.clone()
+        }
+    }
+
+    /// Lᵀ(x − centre): the point in the coordinates where the Laplace scale matrix is the
+    /// identity.
+    pub fn whiten(&self, x: &[f64]) -> DVector<f64> {
+        let r = DVector::from_iterator(
+            self.dim(),
+            x.iter().zip(self.mean.iter()).map(|(a, m)| a - m),
+        );
+        &self.l_t * r
+    }
+
+    /// centre + L⁻ᵀz: the inverse of [`whiten`](Self::whiten).
+    pub fn unwhiten(&self, z: &DVector<f64>) -> Vec<f64> {
+        (&self.mean + &self.l_inv_t * z).iter().copied().collect()
+    }
+
     /// One draw.
     pub fn draw(&self, rng: &mut ChainRng) -> Vec<f64> {
         let d = self.dim();
