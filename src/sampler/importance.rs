@@ -73,13 +73,15 @@ struct Block {
 /// already near the new centre, whose weights are less uneven.
 pub const RECENTRING_ROUNDS: usize = 2;
 
-/// Proposals per chain spent recentring when no warm-up is given (see `default_warmup`).
+/// Proposals per chain spent recentring when no warm-up is given (see `default_warmup`): a
+/// quarter of the default 1000.
 pub const IS_WARMUP: usize = 250;
 
-/// `warmup` proposals per chain spent recentring (in [`RECENTRING_ROUNDS`] rounds; 0 keeps the
-/// MAP), then `draws` per chain from the recentred `proposal`, on the densities `make` builds
-/// (one per block, so caches are never shared); all of them Pareto-smoothed together and
-/// resampled to `chains × draws` equal-weight draws.
+/// `chains × draws` proposals on the densities `make` builds (one per block, so caches are never
+/// shared), all Pareto-smoothed together and resampled to as many equal-weight draws. The first
+/// `warmup` of each chain's `draws` (at most a quarter of them, so that most proposals come from
+/// the final centre; 0 keeps the MAP) are drawn in [`RECENTRING_ROUNDS`] recentring rounds: the
+/// warm-up is part of the sample, not extra to it.
 pub fn importance_sample<P, F>(
     proposal: &LaplaceProposal,
     chains: usize,
@@ -96,15 +98,17 @@ where
         return Err(DensityError::fatal("importance sampling needs draws"));
     }
     let mut rngs: Vec<_> = (0..chains).map(|c| chain_rng(seed, c)).collect();
-    let per_round = if warmup >= RECENTRING_ROUNDS {
-        vec![warmup / RECENTRING_ROUNDS; RECENTRING_ROUNDS]
+    let recentring = warmup.min(draws / 4);
+    let per_round = if recentring >= RECENTRING_ROUNDS {
+        vec![recentring / RECENTRING_ROUNDS; RECENTRING_ROUNDS]
     } else {
         Vec::new()
     };
+    let last = draws - per_round.iter().sum::<usize>();
     let mut components: Vec<(LaplaceProposal, usize)> = Vec::new();
     let mut rounds: Vec<Vec<Block>> = Vec::new();
     let mut current = proposal.clone();
-    for n in per_round.iter().copied().chain([draws]) {
+    for n in per_round.iter().copied().chain([last]) {
         let blocks: Vec<Block> = rngs
             .par_iter_mut()
             .enumerate()
@@ -362,8 +366,8 @@ mod tests {
         };
         assert!(miss(&fixed.centre) > 1.0, "{}", miss(&fixed.centre));
         assert!(miss(&moved.centre) < 0.3, "{}", miss(&moved.centre));
-        // The warm-up's 1000 proposals count too: 5000 weighed, 4000 resampled.
-        assert_eq!(moved.psis.log_weights.len(), 5000);
+        // The warm-up's proposals are a quarter of the draws: 4000 weighed, 4000 resampled.
+        assert_eq!(moved.psis.log_weights.len(), 4000);
         assert!(moved.chains.iter().all(|c| c.draws.len() == 1000));
         assert_eq!(moved.chains[0].warmup.density_evaluations, 250);
         assert!(
