@@ -19,3 +19,4 @@ for c in cases:
 print(f"\nsame selection and verdict: {same} of {len(cases)}")
 print(f"median user s: A {statistics.median(ua):.2f}, B {statistics.median(ub):.2f}; median wall s: A {statistics.median(wa):.2f}, B {statistics.median(wb):.2f}")
 print(f"median of per-case wall ratios B/A: {statistics.median(y / x for x, y in zip(wa, wb)):.2f}")
+print(f"max wall s: A {max(wa):.2f}, B {max(wb):.2f}")
