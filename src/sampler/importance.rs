@@ -16,7 +16,10 @@
 //! from a few hundred effective draws in 45 dimensions is mostly noise (Marchenko–Pastur).
 //! Nothing is thrown away: every round's draws are weighed against the mixture of all rounds'
 //! proposals (the balance heuristic of multiple importance sampling, Veach & Guibas 1995; Owen
-//! & Zhou 2000), and all of them enter the smoothing and the resampling.
+//! & Zhou 2000), and all of them enter the smoothing and the resampling. Half of every round
+//! after the first still comes from the MAP's proposal (defensive importance sampling), so that
+//! a centre moved the wrong way — towards the mean of a skewed marginal, away from its mode —
+//! cannot make the weights' tail much heavier than the MAP's proposal alone would.
 //!
 //! The proposals are made in `chains` parallel blocks, each on its chain's random stream, so the
 //! draws do not depend on the thread count; the weights are smoothed together, and the
@@ -32,7 +35,7 @@ use super::driver::chain_rng;
 use super::proposal::LaplaceProposal;
 use super::{ChainOutput, DrawRecord, PhaseCost, proposal_log_density};
 use crate::density::{Counted, DensityError, LogDensity};
-use crate::diagnostics::{Psis, psis};
+use crate::diagnostics::{KHAT_UNRELIABLE, Psis, psis};
 
 /// The sampler's name in files and tables.
 pub const NAME: &str = "laplace-is";
@@ -73,6 +76,15 @@ struct Block {
 /// already near the new centre, whose weights are less uneven.
 pub const RECENTRING_ROUNDS: usize = 2;
 
+/// The share of every round after the first drawn from the MAP's proposal rather than the
+/// recentred one (defensive importance sampling, Hesterberg 1995). The weighted mean is not the
+/// mode: where the posterior is skewed (a term near its bound) a symmetric proposal moved to the
+/// mean leaves the mode's side thin, and its few draws there carry huge weights. With the MAP's
+/// proposal holding at least this share of the mixture, no draw weighs more than 1/share times
+/// what the MAP's proposal alone would give it, so recentring can cost at most that factor in the
+/// tail and gains wherever the shift is real.
+pub const DEFENSIVE_SHARE: f64 = 0.5;
+
 /// Proposals per chain spent recentring when no warm-up is given (see `default_warmup`): a
 /// quarter of the default 1000.
 pub const IS_WARMUP: usize = 250;
@@ -105,16 +117,26 @@ where
         Vec::new()
     };
     let last = draws - per_round.iter().sum::<usize>();
-    let mut components: Vec<(LaplaceProposal, usize)> = Vec::new();
+    // components[0] is the MAP's proposal, kept in every round (see `DEFENSIVE_SHARE`).
+    let mut components: Vec<(LaplaceProposal, usize)> = vec![(proposal.clone(), 0)];
     let mut rounds: Vec<Vec<Block>> = Vec::new();
     let mut current = proposal.clone();
     for n in per_round.iter().copied().chain([last]) {
+        let defensive = if rounds.is_empty() {
+            n
+        } else {
+            (n as f64 * DEFENSIVE_SHARE).round() as usize
+        };
+        let parts = [(proposal, defensive), (&current, n - defensive)];
         let blocks: Vec<Block> = rngs
             .par_iter_mut()
             .enumerate()
-            .map(|(c, rng)| propose(&current, make(c)?, n, rng))
+            .map(|(c, rng)| propose(&parts, make(c)?, rng))
             .collect::<Result<_, _>>()?;
-        components.push((current.clone(), n * chains));
+        components[0].1 += defensive * chains;
+        if n > defensive {
+            components.push((current.clone(), (n - defensive) * chains));
+        }
         rounds.push(blocks);
         if rounds.len() <= per_round.len() {
             let smoothed = psis(&log_weights(&rounds, &components));
@@ -247,7 +269,9 @@ fn recentre(current: &LaplaceProposal, rounds: &[Vec<Block>], smoothed: &Psis) -
             variance += r.component_mul(&r) * *w;
         }
     }
-    if !(ess > 1.0) || !mean.iter().all(|m| m.is_finite()) {
+    // Beyond k̂ = 0.7 no PSIS estimate is trusted (Vehtari et al. 2024), the weighted mean's
+    // included: a move would follow the noise of a few heavy draws, so the centre stays.
+    if !(smoothed.khat < KHAT_UNRELIABLE) || !(ess > 1.0) || !mean.iter().all(|m| m.is_finite()) {
         return current.clone();
     }
     let shift = DVector::from_iterator(
@@ -263,20 +287,22 @@ fn recentre(current: &LaplaceProposal, rounds: &[Vec<Block>], smoothed: &Psis) -
     current.recentred(&current.unwhiten(&shift))
 }
 
+/// One chain's block of a round: `n` draws from each `(proposal, n)` part in turn.
 fn propose<P: LogDensity>(
-    proposal: &LaplaceProposal,
+    parts: &[(&LaplaceProposal, usize)],
     density: P,
-    draws: usize,
     rng: &mut super::ChainRng,
 ) -> Result<Block, DensityError> {
     let watch = Stopwatch::start();
     let mut density = Counted::new(density);
+    let draws = parts.iter().map(|p| p.1).sum();
     let mut block = Block {
         x: Vec::with_capacity(draws),
         log_density: Vec::with_capacity(draws),
         cost: PhaseCost::default(),
     };
-    for _ in 0..draws {
+    let each = parts.iter().flat_map(|&(q, n)| std::iter::repeat_n(q, n));
+    for proposal in each {
         let x = proposal.draw(rng);
         let lp = proposal_log_density(&mut density, &x)?;
         block.x.push(x);
