@@ -18,11 +18,19 @@
 //! of R and c_g/J against the predicted ones.
 //!
 //!   cargo run --release --example design_study -- pin [--records 30]
+//!
+//! With `pin --posterior SAMPLER` instead, one noisy record of each input goes through the
+//! library's Bayesian fit (`Problem::posterior` with BM1, `pipeline::run_sampler`, the path
+//! `motorcal fit` takes), and the posterior sds of R and c_g/J (over the pooled draws) are
+//! set against the predicted ones.
+//!
+//!   cargo run --release --example design_study -- pin --posterior nuts-dense
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::time::Instant;
 
+use motorcal::bayes::ModelSettings;
 use motorcal::design::{
     self, Candidate, DesignSettings, Experiment, Limits, SearchSettings, Target, design_problem,
     design_times,
@@ -30,6 +38,10 @@ use motorcal::design::{
 use motorcal::discover::{DiscoverSettings, EVIDENCE_THRESHOLD, discover, fit_candidate};
 use motorcal::io::{ModelFile, read_model_file};
 use motorcal::motor::{MotorParameters, VoltageInput};
+use motorcal::pipeline::{
+    MetricAdaptation, RunOutput, RunSettings, SamplerKind, default_warmup, run_sampler,
+};
+use motorcal::sampler::ChainSettings;
 use motorcal::study::Problem;
 use motorcal::synthetic::generate;
 
@@ -46,6 +58,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let records = option("--records")?;
     let diagnosed = option("--diagnose")?.unwrap_or(0);
+    let sampler = args
+        .iter()
+        .position(|a| a == "--posterior")
+        .and_then(|i| args.get(i + 1))
+        .map(|s| s.parse::<SamplerKind>())
+        .transpose()?;
     match args.first().map(String::as_str) {
         Some("separate") if args.len() >= 3 => separate(
             PathBuf::from(&args[1]),
@@ -53,8 +71,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             records.unwrap_or(20),
             diagnosed,
         ),
-        Some("pin") => pin(records.unwrap_or(30)),
-        _ => Err("usage: design_study separate DIR a,b [--records N] | pin [--records N]".into()),
+        Some("pin") => pin(records.unwrap_or(30), sampler),
+        _ => Err(
+            "usage: design_study separate DIR a,b [--records N] [--diagnose N] | pin \
+                  [--records N] [--posterior SAMPLER]"
+                .into(),
+        ),
     }
 }
 
@@ -185,7 +207,7 @@ fn separate(
     Ok(())
 }
 
-fn pin(records: usize) -> Result<(), Box<dyn std::error::Error>> {
+fn pin(records: usize, sampler: Option<SamplerKind>) -> Result<(), Box<dyn std::error::Error>> {
     let model = ModelFile {
         motor: MotorParameters::paper_simulation_model(),
         ..ModelFile::default()
@@ -208,6 +230,26 @@ fn pin(records: usize) -> Result<(), Box<dyn std::error::Error>> {
         ("designed", &designed, &d.pinned),
         ("constant 24 V", &constant, &d.fixed_experiments[0].1),
     ] {
+        if let Some(sampler) = sampler {
+            let started = Instant::now();
+            let (r, ratio, run) = posterior_sds(&candidate, &experiment, input, sampler)?;
+            println!(
+                "  {name}: predicted sd R {:.3e}, c_g/J {:.4}; {} posterior of one record \
+                 (seed 9000) sd R {r:.3e}, c_g/J {ratio:.4}; posterior over predicted: R {:.3}, \
+                 c_g/J {:.3} (max R-hat {:.3}, min bulk ESS {:.0}, k̂ {}, fell back {}, {:.1} s)",
+                predicted.sd["R"],
+                predicted.sd["c_g/J"],
+                sampler.name(),
+                r / predicted.sd["R"],
+                ratio / predicted.sd["c_g/J"],
+                run.max_rhat,
+                run.min_ess_bulk,
+                run.khat.map_or("—".into(), |k| format!("{k:.2}")),
+                run.fell_back,
+                started.elapsed().as_secs_f64()
+            );
+            continue;
+        }
         let (r, ratio) = empirical_sds(&candidate, &experiment, input, records)?;
         println!(
             "  {name}: predicted sd R {:.3e}, c_g/J {:.4}; over {records} fitted records R {:.3e}, \
@@ -222,6 +264,56 @@ fn pin(records: usize) -> Result<(), Box<dyn std::error::Error>> {
         fixed.sd["c_g/J"] / d.pinned.sd["c_g/J"]
     );
     Ok(())
+}
+
+/// The posterior sds of R and c_g/J from the library's Bayesian fit (BM1, the model file's
+/// priors, σ estimated) of one noisy record of the candidate under `input`.
+fn posterior_sds(
+    candidate: &Candidate,
+    experiment: &Experiment,
+    input: &VoltageInput,
+    sampler: SamplerKind,
+) -> Result<(f64, f64, RunOutput), Box<dyn std::error::Error>> {
+    let motor = candidate.problem.model.model(input.clone())?;
+    let data = generate(&motor, &experiment.times, &experiment.noise_sd, 9000)?;
+    let VoltageInput::Held { values, .. } = input else {
+        return Err("the inputs here are held voltages".into());
+    };
+    let problem = Problem {
+        label: "pin".into(),
+        recordings: vec![motorcal::study::recording_from(
+            &data,
+            "pin",
+            Some(values.clone()),
+        )],
+        model: candidate.problem.model.clone(),
+        reference: None,
+    };
+    let mut posterior = problem.posterior(&ModelSettings::bm1())?;
+    let settings = RunSettings {
+        sampler,
+        chain: ChainSettings {
+            warmup: default_warmup(sampler, MetricAdaptation::default()),
+            ..ChainSettings::default()
+        },
+        seed: 9000,
+        quiet: true,
+        ..RunSettings::default()
+    };
+    let run = run_sampler(&mut posterior, &settings, "pin")?;
+    let mut r = Vec::new();
+    let mut ratio = Vec::new();
+    for chain in &run.chains {
+        let at = |p: &str| chain.names.iter().position(|n| n == p);
+        let (Some(ir), Some(ic), Some(ij)) = (at("R"), at("c_g"), at("J")) else {
+            return Err(format!("the draws name {:?}, not R, c_g and J", chain.names).into());
+        };
+        for d in &chain.draws {
+            r.push(d[ir]);
+            ratio.push(d[ic] / d[ij]);
+        }
+    }
+    Ok((sd(&r), sd(&ratio), run))
 }
 
 /// The sds of the least-squares estimates of R and c_g/J over noisy records of the candidate.

@@ -10,6 +10,9 @@ use motorcal::design::{
     design_times,
 };
 use motorcal::io::{read_model_file, read_voltage_profile};
+use motorcal::motor::VoltageInput;
+use motorcal::study::{Problem, recording_from};
+use motorcal::synthetic::generate;
 
 fn fixture(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -239,5 +242,161 @@ fn bad_options_get_one_clear_error_and_write_nothing() {
     one_error_line(&o, &["--limits", "no input can meet"]);
     let o = run(&["--duration", "0.05", "--limits", "U=±24,I=±300"]);
     one_error_line(&o, &["--limits", "all three"]);
+    // A drive base's input is a reference (a current command), not a voltage to search.
+    let hsm150 = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/hsm150/model.toml");
+    let o = motorcal(&[
+        "design",
+        "--model",
+        hsm150.to_str().unwrap(),
+        "--pin",
+        "J",
+        "--duration",
+        "0.05",
+        "--rate",
+        "400",
+        "--limits",
+        limits,
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    one_error_line(&o, &["reference", "voltage-driven"]);
+    // Neither candidates nor a diagnosis to take them from.
+    let o = motorcal(&[
+        "design",
+        "--model",
+        model.to_str().unwrap(),
+        "--duration",
+        "0.05",
+        "--rate",
+        "400",
+        "--limits",
+        limits,
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    one_error_line(&o, &["--separate", "--diagnosis"]);
     assert!(!out.exists());
+}
+
+/// A noisy record of the fixture's model with Coulomb friction of `t_c` N·m at 24 V.
+fn coulomb_record(t_c: f64, times: &[f64]) -> Problem {
+    let model = read_model_file(&fixture("motor.toml")).unwrap();
+    let base = design_problem(&model, times).unwrap();
+    let values = BTreeMap::from([("coulomb_friction.T_c".to_string(), t_c)]);
+    let truth = Candidate::new(&base, "coulomb_friction", &values).unwrap();
+    let motor = truth.problem.model.model(VoltageInput::Constant).unwrap();
+    let data = generate(&motor, times, &[2.0, 10.0], 11).unwrap();
+    Problem {
+        label: "recorded".into(),
+        recordings: vec![recording_from(&data, "recorded", None)],
+        model,
+        reference: None,
+    }
+}
+
+#[test]
+fn without_a_diagnosis_the_candidates_sit_at_their_map_on_the_recording() {
+    let times = design_times(0.2, 1000.0).unwrap();
+    let recorded = coulomb_record(0.05, &times);
+    let base = design_problem(&recorded.model, &times).unwrap();
+    let names = ["load_torque".to_string(), "coulomb_friction".to_string()];
+    let (candidates, sd) =
+        design::candidates_without_diagnosis(&base, &names, Some(&recorded)).unwrap();
+    let value = |c: &Candidate, p: &str| c.theta[c.calibrated.iter().position(|n| n == p).unwrap()];
+    // On a record that never reverses both explain the same torque: each finds it.
+    for (c, p) in candidates
+        .iter()
+        .zip(["load_torque.T_0", "coulomb_friction.T_c"])
+    {
+        let v = value(c, p);
+        assert!((v - 0.05).abs() < 0.01, "{p} = {v}");
+        assert!((value(c, "R") - 0.1).abs() < 0.005);
+    }
+    let sd = sd.expect("a fitted recording gives its noise");
+    assert!(
+        (sd[0] / 2.0 - 1.0).abs() < 0.15 && (sd[1] / 10.0 - 1.0).abs() < 0.15,
+        "{sd:?}"
+    );
+}
+
+#[test]
+fn without_a_recording_the_candidates_sit_at_the_model_values_and_a_zero_term_at_its_prior_median()
+{
+    let model = read_model_file(&fixture("motor.toml")).unwrap();
+    let times = design_times(0.05, 400.0).unwrap();
+    let base = design_problem(&model, &times).unwrap();
+    let names = ["none".to_string(), "coulomb_friction".to_string()];
+    let (candidates, sd) = design::candidates_without_diagnosis(&base, &names, None).unwrap();
+    assert!(sd.is_none());
+    assert_eq!(candidates[0].theta, [0.1]);
+    let c = &candidates[1];
+    let t_c = c.theta[c
+        .calibrated
+        .iter()
+        .position(|n| n == "coulomb_friction.T_c")
+        .unwrap()];
+    // T_c's default, zero, would make the candidate the model itself.
+    assert!(t_c > 0.0 && t_c.is_finite());
+}
+
+#[test]
+fn design_fits_the_named_candidates_to_a_recording_when_no_diagnosis_is_given() {
+    let dir = scratch("fitted");
+    let sim = dir.join("sim");
+    let o = motorcal(&[
+        "simulate",
+        "--effect",
+        "coulomb_friction",
+        "--magnitude",
+        "3",
+        "--input",
+        "constant",
+        "--seed",
+        "4",
+        "--samples",
+        "200",
+        "--t-end",
+        "0.2",
+        "--out",
+        sim.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let out = dir.join("design");
+    let o = motorcal(&[
+        "design",
+        "--model",
+        sim.join("motor.toml").to_str().unwrap(),
+        "--data",
+        sim.join("recording.csv").to_str().unwrap(),
+        "--separate",
+        "load_torque,coulomb_friction",
+        "--duration",
+        "0.05",
+        "--rate",
+        "400",
+        "--limits",
+        "U=±24,I=±300,omega=±3000",
+        "--segments",
+        "3",
+        "--starts",
+        "1",
+        "--draws",
+        "2",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("design.json")).unwrap()).unwrap();
+    assert_eq!(
+        json["candidates_at"]["source"],
+        "their MAP on the recordings"
+    );
+    let t_c = json["candidates_at"]["values"]["coulomb_friction"]["coulomb_friction.T_c"]
+        .as_f64()
+        .unwrap();
+    assert!(t_c > 0.0);
+    // The noise is the recording's, not the paper's 2 A and 10 rad/s to the digit.
+    assert_ne!(json["noise_sd"]["I"], 2.0);
+    assert!(json["expected_gap_nats"].is_f64());
 }

@@ -14,7 +14,8 @@ use crate::design::{
 };
 use crate::io::{VoltageProfile, read_model_file, write_atomically, write_voltage_profile};
 use crate::motor::{MotorParam, VoltageInput};
-use crate::plot::{ChannelPrediction, PredictivePlot, posterior_predictive};
+use crate::plot::{DesignChannel, DesignPlot, design_figure};
+use crate::study::Problem;
 
 use super::AppError;
 
@@ -27,6 +28,10 @@ pub struct DesignArgs {
     /// A `diagnose --json` report: the candidates' fits and the noise σ.
     #[arg(long)]
     pub diagnosis: Option<PathBuf>,
+    /// Without --diagnosis: a recording to fit the --separate candidates to (repeat for
+    /// several); without either they sit at the model's values.
+    #[arg(long, conflicts_with = "diagnosis")]
+    pub data: Vec<PathBuf>,
     /// Candidates to tell apart (default: the diagnosis's selected term and its ties).
     #[arg(long, value_delimiter = ',')]
     pub separate: Option<Vec<String>>,
@@ -47,7 +52,8 @@ pub struct DesignArgs {
     pub segments: usize,
     #[arg(long, default_value_t = 2026)]
     pub seed: u64,
-    /// Noise σ of I [A] and ω [rad/s] (default: the diagnosis's, else the paper's 2 and 10).
+    /// Noise σ of I [A] and ω [rad/s] (default: the diagnosis's or the fitted recording's,
+    /// else the paper's 2 and 10).
     #[arg(long, num_args = 2, value_names = ["SD_I", "SD_OMEGA"])]
     pub noise_sd: Option<Vec<f64>>,
     /// Search starts (run in parallel).
@@ -72,7 +78,7 @@ pub fn run(args: &DesignArgs) -> Result<(), AppError> {
     let times = design_times(args.duration, args.rate)?;
     let base = design_problem(&model, &times)?;
     let diagnosis = args.diagnosis.as_deref().map(read_diagnosis).transpose()?;
-    let noise_sd = noise_sd(args, diagnosis.as_ref())?;
+    let mut noise_sd = noise_sd(args, diagnosis.as_ref())?;
     let settings = DesignSettings {
         search: SearchSettings {
             segments: args.segments,
@@ -113,21 +119,22 @@ pub fn run(args: &DesignArgs) -> Result<(), AppError> {
         });
         let figure = Figure {
             title: format!("design: pin {}", pins.join(", ")),
-            truth: y.clone(),
-            rival: y,
+            truth_name: "model".into(),
+            truth: y,
+            rival: None,
         };
         (report, d.values, figure)
     } else {
-        let Some(diagnosis) = &diagnosis else {
-            return Err(AppError::Usage(
-                "--diagnosis is needed to separate candidates (their fits and the noise), or \
-                 give --pin"
-                    .into(),
-            ));
-        };
-        let names = match &args.separate {
-            Some(names) => names.clone(),
-            None => default_candidates(diagnosis)?,
+        let names = match (&args.separate, &diagnosis) {
+            (Some(names), _) => names.clone(),
+            (None, Some(diagnosis)) => default_candidates(diagnosis)?,
+            (None, None) => {
+                return Err(AppError::Usage(
+                    "name the candidates to tell apart with --separate (or give --diagnosis, \
+                     whose selected term and ties they default to), or give --pin"
+                        .into(),
+                ));
+            }
         };
         if names.len() < 2 {
             return Err(AppError::Usage(format!(
@@ -135,14 +142,55 @@ pub fn run(args: &DesignArgs) -> Result<(), AppError> {
                 names.join(",")
             )));
         }
-        let candidates = names
+        let (candidates, source) = match &diagnosis {
+            Some(diagnosis) => {
+                let candidates = names
+                    .iter()
+                    .map(|name| {
+                        design::parse_candidate(name)?;
+                        let values = candidate_values(diagnosis, name)?;
+                        Ok(Candidate::new(&base, name, &values)?)
+                    })
+                    .collect::<Result<Vec<_>, AppError>>()?;
+                (candidates, "the diagnosis's estimates")
+            }
+            None => {
+                for name in &names {
+                    design::parse_candidate(name)?;
+                }
+                let recorded = if args.data.is_empty() {
+                    None
+                } else {
+                    Some(Problem::from_files(&args.data, &args.model)?)
+                };
+                let (candidates, sd) =
+                    design::candidates_without_diagnosis(&base, &names, recorded.as_ref())?;
+                if args.noise_sd.is_none()
+                    && let Some(sd) = sd
+                {
+                    noise_sd = sd;
+                }
+                let source = if recorded.is_some() {
+                    "their MAP on the recordings"
+                } else {
+                    "the model's values"
+                };
+                (candidates, source)
+            }
+        };
+        let at: BTreeMap<&str, BTreeMap<&str, f64>> = candidates
             .iter()
-            .map(|name| {
-                design::parse_candidate(name)?;
-                let values = candidate_values(diagnosis, name)?;
-                Ok(Candidate::new(&base, name, &values)?)
+            .map(|c| {
+                let values = c
+                    .calibrated
+                    .iter()
+                    .map(String::as_str)
+                    .zip(c.theta.iter().copied())
+                    .collect();
+                (c.name.as_str(), values)
             })
-            .collect::<Result<Vec<_>, AppError>>()?;
+            .collect();
+        let at = json!({"source": source, "values": at});
         let experiment = Experiment {
             candidates,
             times: times.clone(),
@@ -154,6 +202,7 @@ pub fn run(args: &DesignArgs) -> Result<(), AppError> {
         let report = json!({
             "objective": "separate",
             "candidates": names,
+            "candidates_at": at,
             "expected_gap_nats": d.expected_gap_nats,
             "expected_gap_sd_nats": d.spread_nats,
             "gaps": d.gaps,
@@ -164,14 +213,18 @@ pub fn run(args: &DesignArgs) -> Result<(), AppError> {
             })).collect::<Vec<_>>(),
             "profile": d.profile, "peaks": d.check.peaks,
         });
+        let (truth, rival) = (
+            &experiment.candidates[curves.lead.truth].name,
+            &experiment.candidates[curves.lead.rival].name,
+        );
         let figure = Figure {
             title: format!(
-                "design: {} as truth (line, ±2σ band) against {} fitted to it (points)",
-                experiment.candidates[curves.lead.truth].name,
-                experiment.candidates[curves.lead.rival].name
+                "design: {truth} as truth, {rival} fitted to it (noise-free lead {:.0} nats)",
+                curves.lead.gap
             ),
+            truth_name: truth.clone(),
             truth: curves.truth,
-            rival: curves.rival_fit,
+            rival: Some((rival.clone(), curves.rival_fit)),
         };
         (report, d.values, figure)
     };
@@ -210,10 +263,13 @@ fn prediction(
     Ok((names, y, experiment.times.len()))
 }
 
+/// What design.png draws: the truth's noise-free prediction and, when separating, the name of
+/// its best-fitting rival and that fit (both channel-major).
 struct Figure {
     title: String,
+    truth_name: String,
     truth: Vec<f64>,
-    rival: Vec<f64>,
+    rival: Option<(String, Vec<f64>)>,
 }
 
 fn read_diagnosis(path: &Path) -> Result<Value, AppError> {
@@ -319,35 +375,28 @@ fn write_outputs(
     let text = serde_json::to_string_pretty(report).map_err(|e| AppError::Output(e.to_string()))?;
     write_atomically(&out.join("design.json"), text.as_bytes())?;
     let m = times.len();
-    let mut channels = vec![ChannelPrediction {
-        name: "U".into(),
-        unit: "V".into(),
-        measured: values.to_vec(),
-        model: values.to_vec(),
-        mean: values.to_vec(),
-        lower: values.to_vec(),
-        upper: values.to_vec(),
-        sigma: 0.0,
-    }];
-    for (c, (name, unit)) in [("I", "A"), ("ω", "rad/s")].into_iter().enumerate() {
-        let truth = figure.truth[c * m..(c + 1) * m].to_vec();
-        let band = 2.0 * noise_sd[c];
-        channels.push(ChannelPrediction {
+    let channels = [("I", "A"), ("ω", "rad/s")]
+        .into_iter()
+        .enumerate()
+        .map(|(c, (name, unit))| DesignChannel {
             name: name.into(),
             unit: unit.into(),
-            measured: figure.rival[c * m..(c + 1) * m].to_vec(),
-            model: figure.rival[c * m..(c + 1) * m].to_vec(),
-            lower: truth.iter().map(|v| v - band).collect(),
-            upper: truth.iter().map(|v| v + band).collect(),
-            mean: truth,
+            truth: figure.truth[c * m..(c + 1) * m].to_vec(),
+            rival: figure
+                .rival
+                .as_ref()
+                .map_or(Vec::new(), |(_, y)| y[c * m..(c + 1) * m].to_vec()),
             sigma: noise_sd[c],
-        });
-    }
-    posterior_predictive(
+        })
+        .collect();
+    design_figure(
         &out.join("design.png"),
-        &PredictivePlot {
+        &DesignPlot {
             title: figure.title.clone(),
             times: times.to_vec(),
+            input: values.to_vec(),
+            truth: figure.truth_name.clone(),
+            rival: figure.rival.as_ref().map(|(name, _)| name.clone()),
             channels,
         },
     )

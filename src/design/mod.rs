@@ -6,7 +6,8 @@
 //! for pinning the model's constant U.
 //!
 //! The files: `profile` (the input and its free coordinates), `limits`, `experiment` (the
-//! candidates at their estimates, the sampling and σ), `separate` and `pin` (the objectives),
+//! candidates at their estimates, the sampling and σ), `fitted` (the candidates' estimates
+//! when no diagnosis gives them), `separate` and `pin` (the objectives),
 //! `search` (multi-start Nelder–Mead). Nothing here reads or writes a file: `app::design` does.
 //!
 //! **Limits.** An input is judged on the noise-free predictions of every candidate at the
@@ -17,6 +18,7 @@
 //! never clipped.
 
 mod experiment;
+mod fitted;
 mod limits;
 mod pin;
 mod profile;
@@ -24,6 +26,7 @@ mod search;
 mod separate;
 
 pub use experiment::{Candidate, Experiment, design_problem, design_times, parse_candidate};
+pub use fitted::candidates_without_diagnosis;
 pub use limits::Limits;
 pub use pin::{Pinned, Target, fisher, pin_candidate, pinned};
 pub use profile::{Profile, held};

@@ -11,6 +11,7 @@
 //! logarithmic axis non-positive values are skipped.
 
 mod coefficients;
+mod design;
 mod discrepancy;
 mod ess;
 mod frame;
@@ -27,6 +28,7 @@ use std::fmt;
 use plotters::prelude::DrawingAreaErrorKind;
 
 pub use coefficients::{CoefficientMarginals, coefficient_marginals};
+pub use design::{DesignChannel, DesignPlot, design_figure};
 pub use discrepancy::{DiscrepancyBand, discrepancy_band};
 pub use ess::{SamplerCurve, ess_per_second};
 pub use k_study::{KSeries, k_study};

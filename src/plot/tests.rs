@@ -511,3 +511,59 @@ fn missing_torque_rejects_empty_and_inconsistent_input() {
     plot.curves.clear();
     assert_err_no_file(&p, missing_torque(&p, &plot));
 }
+
+fn design_example(rival: bool) -> DesignPlot {
+    let times: Vec<f64> = (1..=200).map(|i| f64::from(i) / 400.0).collect();
+    let input = times
+        .iter()
+        .map(|t| if *t < 0.25 { 24.0 } else { -12.0 })
+        .collect();
+    let channel = |name: &str, unit: &str, scale: f64, sigma: f64| DesignChannel {
+        name: name.into(),
+        unit: unit.into(),
+        truth: times
+            .iter()
+            .map(|t| scale * (1.0 - (-t / 0.05).exp()))
+            .collect(),
+        rival: if rival {
+            times
+                .iter()
+                .map(|t| scale * (1.0 - (-t / 0.06).exp()))
+                .collect()
+        } else {
+            Vec::new()
+        },
+        sigma,
+    };
+    DesignPlot {
+        title: "design".into(),
+        times: times.clone(),
+        input,
+        truth: "coulomb_friction".into(),
+        rival: rival.then(|| "load_torque".into()),
+        channels: vec![
+            channel("I", "A", 100.0, 2.0),
+            channel("ω", "rad/s", 1500.0, 10.0),
+        ],
+    }
+}
+
+#[test]
+fn the_design_figure_draws_a_separating_and_a_pinning_design() {
+    for rival in [true, false] {
+        let p = out(&format!("design_{rival}"));
+        design_figure(&p, &design_example(rival)).unwrap();
+        assert_png(&p);
+    }
+}
+
+#[test]
+fn the_design_figure_refuses_a_rival_fit_of_the_wrong_length() {
+    let p = out("design_bad");
+    let mut ex = design_example(true);
+    ex.channels[0].rival.pop();
+    let err = design_figure(&p, &ex).unwrap_err();
+    assert!(err.message().contains("rival"), "{err}");
+    assert!(!p.exists());
+    assert_err_no_file(&p, design_figure(&p, &DesignPlot::default()));
+}
