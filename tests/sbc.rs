@@ -511,7 +511,11 @@ fn laplace_is_ranks_the_truth_uniformly_on_bm2_k3_in_100_replications() {
 }
 
 /// 1000 replications of each Laplace sampler on BM2(K = 3) in 20 bins; the report is written
-/// to papers/laplace-samplers/sbc_bm2_k3.txt.
+/// to papers/laplace-samplers/sbc_bm2_k3.txt. When written, this did not finish: after 26 min
+/// of CPU on one thread (40 min under load) it was still in the independence replications,
+/// which at the CI variant's rate (100 in about 25 s) would have taken four minutes — some
+/// replication's chain must need orders of magnitude more draws to mix, as with c_g and J
+/// calibrated (see [`bm2_k3`]); not yet found which.
 #[test]
 #[ignore]
 fn on_bm2_k3_the_laplace_samplers_rank_the_truth_uniformly_in_1000_replications() {
