@@ -1,6 +1,7 @@
 //! Simulation-based calibration (Talts, Betancourt, Simpson, Vehtari & Gelman 2018,
 //! "Validating Bayesian inference algorithms with simulation-based calibration",
-//! arXiv:1804.06788) of NUTS with a dense metric on a small motor posterior.
+//! arXiv:1804.06788) of NUTS with a dense metric and of the two samplers that draw from the
+//! Laplace approximation, on small motor posteriors: BM1, and BM2(K = 3) below.
 //!
 //! If θ̃ is drawn from the prior and data ỹ from the model at θ̃, then θ̃ is an exact draw from
 //! the posterior p(θ | ỹ). Its rank among L independent posterior draws is therefore uniform
@@ -26,20 +27,35 @@
 //! Bonferroni correction over the 3 parameters: every p-value > 0.01/3. The same ranks against
 //! deliberately wrong posteriors (the draws shifted by one posterior sd, or shrunk to a third
 //! of their spread) must fail the same test, which shows that it can.
+//!
+//! BM2(K = 3) is the same set-up with the paper's discrepancy: δ(t) = Σ_j a_j p_j(t) on each
+//! channel, four Legendre terms, added to the simulated channels before the noise. R and σ as
+//! in BM1. a_j ~ Laplace(0, 10) independently, the paper's prior,
+//! read from `ModelSettings::bm2(3)`. That prior has no hyper-parameters to draw (its scale is
+//! fixed), so nothing in the draw can make the problem degenerate the way a drawn scale near
+//! zero could; what remains is the Laplace prior's kink at a = 0, which the MAP search and the
+//! Laplace approximation meet when the noise drawn is large enough to leave a coefficient to
+//! its prior — where that makes the Student-t a poor proposal, laplace-is's k̂ says so and the
+//! run falls back to NUTS, which is then what the ranks test. The prior is kept as stated.
+//! The ranked quantities are R, σ_I and one coefficient of each channel (see [`bm2_k3`]).
+
+mod common;
 
 use std::time::Instant;
 
-use motorcal::bayes::{CalibrationPosterior, ModelSettings, Observations, Prior, ln_gamma};
+use common::chi_square_survival;
+use motorcal::bayes::{CalibrationPosterior, DiscrepancyBasis, Legendre, ModelSettings};
+use motorcal::bayes::{Observations, Prior};
 use motorcal::diagnostics::ess_bulk;
 use motorcal::forward::ForwardModel;
-use motorcal::motor::{MotorModel, MotorParameters, VoltageInput};
+use motorcal::motor::{MotorModel, MotorParam, MotorParameters, VoltageInput};
 use motorcal::ode::SolverSettings;
 use motorcal::pipeline::{MetricAdaptation, RunSettings, SamplerKind, default_warmup, run_sampler};
 use motorcal::sampler::ChainSettings;
 use motorcal::sampler::driver::chain_rng;
 use motorcal::synthetic::{generate, sample_times};
 use rand::Rng;
-use rand_distr::{Distribution, Gamma, StandardNormal};
+use rand_distr::{Distribution, Exp1, Gamma, StandardNormal};
 use rayon::prelude::*;
 
 const SEED: u64 = 180_406_788;
@@ -47,152 +63,51 @@ const SEED: u64 = 180_406_788;
 const L: usize = 99;
 const T_END: f64 = 0.5;
 const SAMPLES: usize = 50;
-const PARAMETERS: [&str; 3] = ["R", "sigma_I", "sigma_omega"];
-/// Family-wise level of the uniformity test, split over the parameters (Bonferroni).
+/// Family-wise level of the uniformity test, split over the ranked quantities (Bonferroni).
 const ALPHA: f64 = 0.01;
 const WARMUP: usize = 300;
 /// Draws of the first attempt; doubled until thinning to ESS leaves L of them.
 const FIRST_DRAWS: usize = 400;
 
 // ---------------------------------------------------------------------------------------------
-// χ² survival function: the regularised upper incomplete gamma Q(a, x) = Γ(a, x)/Γ(a).
+// The posteriors SBC is run on.
 
-/// Q(a, x) for a > 0, x ≥ 0. Below x = a + 1 the power series of P = 1 − Q converges fast;
-/// above, Legendre's continued fraction for Γ(a, x) does (evaluated by the modified Lentz
-/// method). Each is used where it needs the fewest terms and loses no precision to 1 − P.
-fn gamma_q(a: f64, x: f64) -> f64 {
-    assert!(a > 0.0 && x >= 0.0, "Q({a}, {x}) is not defined");
-    if x == 0.0 {
-        1.0
-    } else if x < a + 1.0 {
-        1.0 - gamma_p_series(a, x)
-    } else {
-        gamma_q_continued_fraction(a, x)
+/// A fitted model: its settings, what it calibrates, and which of its reported quantities
+/// have their ranks tested.
+struct Model {
+    settings: ModelSettings,
+    calibrated: &'static [MotorParam],
+    ranked: &'static [&'static str],
+}
+
+/// BM1 calibrating R; every quantity ranked.
+fn bm1() -> Model {
+    Model {
+        settings: ModelSettings::bm1(),
+        calibrated: &[MotorParam::Resistance],
+        ranked: &["R", "sigma_I", "sigma_omega"],
     }
 }
 
-/// e^{−x} x^a / Γ(a), the factor both expansions share, in logs to survive large a and x.
-fn prefactor(a: f64, x: f64) -> f64 {
-    (a * x.ln() - x - ln_gamma(a)).exp()
-}
-
-/// P(a, x) = e^{−x} x^a / Γ(a) · Σ_{n≥0} x^n / (a (a+1) ⋯ (a+n)).
-fn gamma_p_series(a: f64, x: f64) -> f64 {
-    let mut term = 1.0 / a;
-    let mut sum = term;
-    for n in 1..10_000 {
-        term *= x / (a + n as f64);
-        sum += term;
-        if term.abs() < sum.abs() * f64::EPSILON {
-            return sum * prefactor(a, x);
-        }
+/// BM2(K = 3) as the paper fits it: R calibrated, the discrepancy beside it. σ_ω is left out
+/// of the ranks (σ_I stands for the noise levels; BM1 already tests both), and so are all but
+/// one coefficient per channel: a_I.1, the constant term, which trades against the steady
+/// current that R sets, and a_omega.4, the cubic one, the least informed by 50 samples.
+///
+/// Calibrating c_g and J as well (each with R's prior scaled to its nominal value) was tried
+/// first. In its first six replications, independence chains needed 51 200 and 819 200 draws
+/// (thinned by 425 and 4112) to give 99 independent ones, 148 s for the second; in its first
+/// five, laplace-is fell back to NUTS on two, and on a third (k̂ 0.63) its weights' ESS was
+/// about 115 of 12 800 proposals.
+/// (Not examined further; the likely cause is that with σ drawn up to ~10³ the data pin only
+/// combinations of R, c_g and J, and the posterior is a curved ridge.) It made the CI variant
+/// cost many minutes, so the SBC here is of the model the paper fits.
+fn bm2_k3() -> Model {
+    Model {
+        settings: ModelSettings::bm2(3),
+        calibrated: &[MotorParam::Resistance],
+        ranked: &["R", "sigma_I", "a_I.1", "a_omega.4"],
     }
-    panic!("the series of P({a}, {x}) did not converge");
-}
-
-/// Q(a, x) = e^{−x} x^a / Γ(a) · 1/(x+1−a − 1·(1−a)/(x+3−a − 2·(2−a)/(x+5−a − ⋯))), the
-/// even part of Legendre's continued fraction, by the modified Lentz method: the n-th
-/// convergent is the running product of C_n/D_n-style ratios, with tiny values replacing zeros.
-fn gamma_q_continued_fraction(a: f64, x: f64) -> f64 {
-    let tiny = f64::MIN_POSITIVE / f64::EPSILON;
-    let mut b = x + 1.0 - a;
-    let mut c = 1.0 / tiny;
-    let mut d = 1.0 / b;
-    let mut h = d;
-    for n in 1..10_000 {
-        let n = n as f64;
-        let an = -n * (n - a);
-        b += 2.0;
-        d = an * d + b;
-        if d.abs() < tiny {
-            d = tiny;
-        }
-        c = b + an / c;
-        if c.abs() < tiny {
-            c = tiny;
-        }
-        d = 1.0 / d;
-        let delta = d * c;
-        h *= delta;
-        if (delta - 1.0).abs() < f64::EPSILON {
-            return prefactor(a, x) * h;
-        }
-    }
-    panic!("the continued fraction of Q({a}, {x}) did not converge");
-}
-
-/// P(χ²_k > x).
-fn chi_square_survival(x: f64, dof: usize) -> f64 {
-    gamma_q(dof as f64 / 2.0, x / 2.0)
-}
-
-#[test]
-fn the_incomplete_gamma_and_chi_square_tails_match_known_values() {
-    let close = |got: f64, want: f64, what: &str| {
-        assert!(
-            (got - want).abs() <= 1e-12 * want.max(1e-300) + 1e-15,
-            "{what}: {got} vs {want}"
-        );
-    };
-    // Integer a: Q(n, x) = e^{−x} Σ_{k<n} x^k/k!, on both sides of x = a + 1 (series and
-    // continued fraction).
-    for (n, x) in [
-        (1, 0.3),
-        (1, 7.0),
-        (3, 1.0),
-        (3, 10.0),
-        (10, 5.0),
-        (10, 20.0),
-        (25, 24.0),
-        (25, 26.5),
-    ] {
-        let mut term = 1.0;
-        let mut sum = 0.0;
-        for k in 0..n {
-            if k > 0 {
-                term *= x / k as f64;
-            }
-            sum += term;
-        }
-        close(
-            gamma_q(n as f64, x),
-            (-x).exp() * sum,
-            &format!("Q({n}, {x})"),
-        );
-    }
-    // Half-integer a: Q(3/2, x) = erfc(√x) + 2√(x/π) e^{−x}; with erfc(1) = 0.157299207050285…
-    let erfc_1 = 0.157_299_207_050_285_13;
-    close(
-        gamma_q(1.5, 1.0),
-        erfc_1 + 2.0 / std::f64::consts::PI.sqrt() * (-1.0f64).exp(),
-        "Q(3/2, 1)",
-    );
-    close(gamma_q(0.5, 1.0), erfc_1, "Q(1/2, 1)");
-    // Quantiles of χ² tables (scipy.stats.chi2.isf): the survival function inverts them.
-    for (x, dof, p) in [
-        (3.841_458_820_694_124, 1, 0.05),
-        (9.487_729_036_781_154, 4, 0.05),
-        (13.276_704_135_987_622, 4, 0.01),
-        (21.665_994_333_461_924, 9, 0.01),
-        (30.143_527_205_646_16, 19, 0.05),
-        (2.087_900_774_933_263_5, 9, 0.99),
-    ] {
-        let got = chi_square_survival(x, dof);
-        assert!(
-            (got - p).abs() < 1e-9,
-            "P(χ²_{dof} > {x}) = {got}, tables say {p}"
-        );
-    }
-    assert_eq!(chi_square_survival(0.0, 4), 1.0);
-    assert!(chi_square_survival(200.0, 4) < 1e-40);
-}
-
-// ---------------------------------------------------------------------------------------------
-// One replication.
-
-/// The fitted model: BM1 with its default priors.
-fn model_settings() -> ModelSettings {
-    ModelSettings::bm1()
 }
 
 /// The nominal (fitted) motor: the paper's true motor, c_g = 0.01.
@@ -200,50 +115,105 @@ fn nominal() -> MotorParameters {
     MotorParameters::default()
 }
 
-/// θ̃ = (R, σ_I, σ_ω) from the fitted posterior's own prior.
-fn draw_from_prior(rng: &mut impl Rng) -> [f64; 3] {
-    let settings = model_settings();
-    let Prior::Normal { mean, sd } = settings.resistance_prior(nominal().resistance) else {
-        panic!("BM1's prior on R is normal");
-    };
-    let resistance = loop {
+/// A normal draw truncated to > 0: the posterior is zero at and below 0 for these
+/// untransformed parameters, so the prior it actually uses is truncated there.
+fn positive_normal(rng: &mut impl Rng, mean: f64, sd: f64) -> f64 {
+    loop {
         let z: f64 = StandardNormal.sample(rng);
-        let r = mean + sd * z;
-        // The posterior is zero for R ≤ 0: the prior it actually uses is truncated there.
-        if r > 0.0 {
-            break r;
+        let x = mean + sd * z;
+        if x > 0.0 {
+            return x;
         }
-    };
+    }
+}
+
+/// θ̃ from the fitted posterior's own prior, in its reported order: the calibrated
+/// parameters, σ per channel, then each channel's coefficients. BM1 takes the random numbers
+/// in the order it always has, so its replications are unchanged.
+fn draw_from_prior(model: &Model, rng: &mut impl Rng) -> Vec<f64> {
+    let settings = &model.settings;
+    let mut truth = Vec::new();
+    for &p in model.calibrated {
+        let Prior::Normal { mean, sd } = settings.resistance_prior(nominal().get(p)) else {
+            panic!("the paper's prior of a calibrated parameter is normal");
+        };
+        truth.push(positive_normal(rng, mean, sd));
+    }
     // σ ~ InvGamma(α, β) ⇔ 1/σ ~ Gamma(shape α, rate β) = Gamma(α, scale 1/β).
     let precision = Gamma::new(settings.noise_prior_shape, 1.0 / settings.noise_prior_scale)
         .expect("a valid gamma");
-    let mut sigma = || 1.0 / precision.sample(rng);
-    [resistance, sigma(), sigma()]
+    for _ in 0..2 {
+        truth.push(1.0 / precision.sample(rng));
+    }
+    if let Some(k) = settings.discrepancy_degree {
+        for _ in 0..2 {
+            for j in 0..=k {
+                let Prior::Laplace { location, scale } = settings.coefficient_prior.prior(j) else {
+                    panic!("the paper's coefficient prior is Laplace");
+                };
+                // The difference of two unit exponentials is Laplace(0, 1).
+                let e: [f64; 2] = [Exp1.sample(rng), Exp1.sample(rng)];
+                truth.push(location + scale * (e[0] - e[1]));
+            }
+        }
+    }
+    truth
 }
 
 /// The posterior of one replication's data. Its ODE tolerance (10⁻⁸ relative) is the fit's
 /// default, looser than the generator's 10⁻¹⁰: a model error of ~10⁻⁶ A on signals of ~10² A,
 /// five orders of magnitude below the smallest noise the prior makes.
-fn posterior_for(data: Vec<Vec<f64>>, times: &[f64]) -> CalibrationPosterior {
-    let model = MotorModel::new(nominal(), VoltageInput::Constant);
-    let forward = ForwardModel::new(model, times.to_vec(), &["R"], SolverSettings::default())
+fn posterior_for(model: &Model, data: Vec<Vec<f64>>, times: &[f64]) -> CalibrationPosterior {
+    let motor = MotorModel::new(nominal(), VoltageInput::Constant);
+    let names: Vec<&str> = model.calibrated.iter().map(|p| p.key()).collect();
+    let forward = ForwardModel::new(motor, times.to_vec(), &names, SolverSettings::default())
         .expect("a valid forward model");
     let obs = Observations {
         label: "sbc".into(),
         channels: data,
     };
-    CalibrationPosterior::new(vec![(forward, obs)], &model_settings()).expect("a posterior")
+    CalibrationPosterior::new(vec![(forward, obs)], &model.settings).expect("a posterior")
 }
 
+/// Data at θ̃: the motor with the drawn parameters, δ(ã) added to each channel, and noise
+/// of the drawn σ̃.
+fn simulate(model: &Model, truth: &[f64], times: &[f64], noise_seed: u64) -> Vec<Vec<f64>> {
+    let n = model.calibrated.len();
+    let mut motor = nominal();
+    for (&p, &value) in model.calibrated.iter().zip(truth) {
+        motor.set(p, value);
+    }
+    let motor = MotorModel::new(motor, VoltageInput::Constant);
+    let mut data = generate(&motor, times, &truth[n..n + 2], noise_seed)
+        .expect("the drawn motor simulates")
+        .measured;
+    if let Some(k) = model.settings.discrepancy_degree {
+        // The basis the posterior builds: on [0, last sample time].
+        let basis = Legendre::new(k, T_END)
+            .expect("a valid basis")
+            .matrix(times);
+        for (c, channel) in data.iter_mut().enumerate() {
+            let a = &truth[n + 2 + c * (k + 1)..n + 2 + (c + 1) * (k + 1)];
+            for (i, y) in channel.iter_mut().enumerate() {
+                *y += (0..=k).map(|j| basis[(i, j)] * a[j]).sum::<f64>();
+            }
+        }
+    }
+    data
+}
+
+// ---------------------------------------------------------------------------------------------
+// One replication.
+
 /// What one replication gives: ranks of θ̃ among the posterior draws, and among the same draws
-/// made wrong on purpose.
+/// made wrong on purpose, for each ranked quantity.
 struct Replication {
-    truth: [f64; 3],
-    ranks: [usize; 3],
+    truth: Vec<f64>,
+    ranks: Vec<usize>,
     /// Ranks among the draws shifted up by one posterior sd.
-    shifted: [usize; 3],
+    shifted: Vec<usize>,
     /// Ranks among the draws shrunk to a third of their spread about their mean.
-    narrowed: [usize; 3],
+    narrowed: Vec<usize>,
     draws: usize,
     thin: usize,
     min_ess: f64,
@@ -259,25 +229,27 @@ fn rank(truth: f64, draws: impl Iterator<Item = f64>) -> usize {
 
 /// Replication `r`: its prior draw, noise and chains all come from stream `r` of `SEED`, so
 /// it gives the same result whichever thread runs it and however many run.
-fn replicate(r: usize, sampler: SamplerKind) -> Replication {
+fn replicate(model: &Model, r: usize, sampler: SamplerKind) -> Replication {
     let mut rng = chain_rng(SEED, r);
-    let truth = draw_from_prior(&mut rng);
+    let truth = draw_from_prior(model, &mut rng);
     let noise_seed = rng.next_u64();
     let chain_seed = rng.next_u64();
 
     let times = sample_times(T_END, SAMPLES);
-    let motor = MotorModel::new(
-        MotorParameters {
-            resistance: truth[0],
-            ..nominal()
-        },
-        VoltageInput::Constant,
-    );
-    let data = generate(&motor, &times, &truth[1..], noise_seed)
-        .unwrap_or_else(|e| panic!("replication {r}: {e}"));
-    let mut post = posterior_for(data.measured, &times);
+    let data = simulate(model, &truth, &times, noise_seed);
+    let mut post = posterior_for(model, data, &times);
     let names = motorcal::density::LogDensity::output_names(&post);
-    assert_eq!(names, PARAMETERS, "the quantities SBC ranks");
+    assert_eq!(names.len(), truth.len(), "the truth is drawn in {names:?}");
+    let ranked: Vec<usize> = model
+        .ranked
+        .iter()
+        .map(|q| {
+            names
+                .iter()
+                .position(|n| n == q)
+                .expect("a reported quantity")
+        })
+        .collect();
 
     let mut n_draws = FIRST_DRAWS;
     loop {
@@ -300,7 +272,7 @@ fn replicate(r: usize, sampler: SamplerKind) -> Replication {
         let run = run_sampler(&mut post, &settings, "sbc")
             .unwrap_or_else(|e| panic!("replication {r} (θ̃ = {truth:?}): {e}"));
         let chain = &run.chains[0];
-        let columns: Vec<Vec<f64>> = (0..3).map(|j| chain.column(j)).collect();
+        let columns: Vec<Vec<f64>> = ranked.iter().map(|&j| chain.column(j)).collect();
         // For laplace-is the run's min ESS is also capped by its weights' ESS: resampled
         // draws repeat, and thinning to the column's ESS alone would keep too many copies.
         let min_ess = columns
@@ -316,10 +288,10 @@ fn replicate(r: usize, sampler: SamplerKind) -> Replication {
         }
         let kept: Vec<usize> = (0..L).map(|i| n_draws - 1 - i * thin).collect();
         let mut out = Replication {
-            truth,
-            ranks: [0; 3],
-            shifted: [0; 3],
-            narrowed: [0; 3],
+            truth: truth.clone(),
+            ranks: Vec::new(),
+            shifted: Vec::new(),
+            narrowed: Vec::new(),
             draws: n_draws,
             thin,
             min_ess,
@@ -327,14 +299,18 @@ fn replicate(r: usize, sampler: SamplerKind) -> Replication {
             khat: run.khat,
             fell_back: run.fell_back,
         };
-        for j in 0..3 {
-            let draws: Vec<f64> = kept.iter().map(|&i| columns[j][i]).collect();
+        for (column, &j) in columns.iter().zip(&ranked) {
+            let draws: Vec<f64> = kept.iter().map(|&i| column[i]).collect();
             let mean = draws.iter().sum::<f64>() / L as f64;
             let sd =
                 (draws.iter().map(|d| (d - mean).powi(2)).sum::<f64>() / (L - 1) as f64).sqrt();
-            out.ranks[j] = rank(truth[j], draws.iter().copied());
-            out.shifted[j] = rank(truth[j], draws.iter().map(|d| d + sd));
-            out.narrowed[j] = rank(truth[j], draws.iter().map(|d| mean + (d - mean) / 3.0));
+            out.ranks.push(rank(truth[j], draws.iter().copied()));
+            out.shifted
+                .push(rank(truth[j], draws.iter().map(|d| d + sd)));
+            out.narrowed.push(rank(
+                truth[j],
+                draws.iter().map(|d| mean + (d - mean) / 3.0),
+            ));
         }
         return out;
     }
@@ -364,13 +340,14 @@ fn uniformity_p_value(counts: &[usize]) -> f64 {
     chi_square_survival(statistic, counts.len() - 1)
 }
 
-/// p-values per parameter of the ranks picked by `which`, with their histograms.
+/// p-values per ranked quantity of the ranks picked by `which`, with their histograms.
 fn p_values(
     reps: &[Replication],
+    quantities: usize,
     bins: usize,
-    which: impl Fn(&Replication) -> [usize; 3],
+    which: impl Fn(&Replication) -> &[usize],
 ) -> Vec<(f64, Vec<usize>)> {
-    (0..3)
+    (0..quantities)
         .map(|j| {
             let counts = histogram(reps.iter().map(|r| which(r)[j]), bins);
             (uniformity_p_value(&counts), counts)
@@ -378,12 +355,12 @@ fn p_values(
         .collect()
 }
 
-fn calibration(replications: usize, bins: usize, sampler: SamplerKind) -> String {
+fn calibration(model: &Model, replications: usize, bins: usize, sampler: SamplerKind) -> String {
     let started = Instant::now();
     // Ordered by r whatever the thread count: the outcome does not depend on it.
     let reps: Vec<Replication> = (0..replications)
         .into_par_iter()
-        .map(|r| replicate(r, sampler))
+        .map(|r| replicate(model, r, sampler))
         .collect();
     let seconds = started.elapsed().as_secs_f64();
 
@@ -391,17 +368,19 @@ fn calibration(replications: usize, bins: usize, sampler: SamplerKind) -> String
     let mean_thin = reps.iter().map(|r| r.thin as f64).sum::<f64>() / reps.len() as f64;
     let min_ess = reps.iter().map(|r| r.min_ess).fold(f64::INFINITY, f64::min);
     let longest = reps.iter().map(|r| r.draws).max().unwrap_or(0);
+    let n_theta = model.calibrated.len();
     let sigma_range = reps
         .iter()
-        .flat_map(|r| r.truth[1..].to_vec())
+        .flat_map(|r| r.truth[n_theta..n_theta + 2].to_vec())
         .fold((f64::INFINITY, 0.0f64), |(lo, hi), s| {
             (lo.min(s), hi.max(s))
         });
     let mut report = format!(
-        "SBC, {} on BM1: {replications} replications × {L} draws, {bins} bins, {seconds:.1} s; \
+        "SBC, {} on {}: {replications} replications × {L} draws, {bins} bins, {seconds:.1} s; \
          σ̃ from {:.3} to {:.1}; thinning mean {mean_thin:.2}, lowest ESS {min_ess:.0}, \
          longest chain {longest}; {divergences} divergences\n",
         sampler.name(),
+        model.settings.label(),
         sigma_range.0,
         sigma_range.1
     );
@@ -419,11 +398,12 @@ fn calibration(replications: usize, bins: usize, sampler: SamplerKind) -> String
         ));
     }
 
-    let threshold = ALPHA / PARAMETERS.len() as f64;
-    let sampled = p_values(&reps, bins, |r| r.ranks);
-    let shifted = p_values(&reps, bins, |r| r.shifted);
-    let narrowed = p_values(&reps, bins, |r| r.narrowed);
-    for (j, name) in PARAMETERS.iter().enumerate() {
+    let quantities = model.ranked.len();
+    let threshold = ALPHA / quantities as f64;
+    let sampled = p_values(&reps, quantities, bins, |r| &r.ranks);
+    let shifted = p_values(&reps, quantities, bins, |r| &r.shifted);
+    let narrowed = p_values(&reps, quantities, bins, |r| &r.narrowed);
+    for (j, name) in model.ranked.iter().enumerate() {
         report.push_str(&format!(
             "{name:>12}: p = {:.4} {:?}; shifted by 1 sd p = {:.1e} {:?}; \
              shrunk to sd/3 p = {:.1e} {:?}\n",
@@ -432,7 +412,7 @@ fn calibration(replications: usize, bins: usize, sampler: SamplerKind) -> String
     }
     eprint!("{report}");
     let mut failures = Vec::new();
-    for (j, name) in PARAMETERS.iter().enumerate() {
+    for (j, name) in model.ranked.iter().enumerate() {
         // Written so that a NaN p-value fails too.
         let uniform = sampled[j].0 > threshold;
         if !uniform {
@@ -461,22 +441,32 @@ fn calibration(replications: usize, bins: usize, sampler: SamplerKind) -> String
     report
 }
 
+/// Writes a long run's report beside the paper, its command as the first line.
+fn write_report(file: &str, command: &str, report: &str) {
+    let path = format!(
+        "{}/papers/laplace-samplers/{file}",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    std::fs::create_dir_all(std::path::Path::new(&path).parent().unwrap()).unwrap();
+    std::fs::write(path, format!("# {command}\n{report}")).unwrap();
+}
+
 /// 100 replications in 10 bins (10 expected per bin), about 15 s: coarse, but a posterior off
 /// by one sd or three times too narrow fails it by orders of magnitude.
 #[test]
 fn nuts_ranks_the_truth_uniformly_in_100_replications() {
-    calibration(100, 10, SamplerKind::NutsDense);
+    calibration(&bm1(), 100, 10, SamplerKind::NutsDense);
 }
 
 /// The same 100 replications for the samplers that draw from the Laplace approximation.
 #[test]
 fn independence_ranks_the_truth_uniformly_in_100_replications() {
-    calibration(100, 10, SamplerKind::Independence);
+    calibration(&bm1(), 100, 10, SamplerKind::Independence);
 }
 
 #[test]
 fn laplace_is_ranks_the_truth_uniformly_in_100_replications() {
-    calibration(100, 10, SamplerKind::LaplaceIs);
+    calibration(&bm1(), 100, 10, SamplerKind::LaplaceIs);
 }
 
 /// Ten times Talts et al.'s 100: 1000 replications in 20 bins (50 expected per bin), which
@@ -484,7 +474,7 @@ fn laplace_is_ranks_the_truth_uniformly_in_100_replications() {
 #[test]
 #[ignore]
 fn nuts_ranks_the_truth_uniformly_in_1000_replications() {
-    calibration(1000, 20, SamplerKind::NutsDense);
+    calibration(&bm1(), 1000, 20, SamplerKind::NutsDense);
 }
 
 /// 1000 replications of each Laplace sampler; the report is written to
@@ -492,15 +482,64 @@ fn nuts_ranks_the_truth_uniformly_in_1000_replications() {
 #[test]
 #[ignore]
 fn the_laplace_samplers_rank_the_truth_uniformly_in_1000_replications() {
-    let mut report =
-        String::from("# cargo test --release --test sbc -- --ignored the_laplace_samplers\n");
+    let mut report = String::new();
     for sampler in [SamplerKind::Independence, SamplerKind::LaplaceIs] {
-        report.push_str(&calibration(1000, 20, sampler));
+        report.push_str(&calibration(&bm1(), 1000, 20, sampler));
     }
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/papers/laplace-samplers/sbc_bm1.txt"
+    write_report(
+        "sbc_bm1.txt",
+        "cargo test --release --test sbc -- --ignored the_laplace_samplers",
+        &report,
     );
-    std::fs::create_dir_all(std::path::Path::new(path).parent().unwrap()).unwrap();
-    std::fs::write(path, report).unwrap();
+}
+
+/// BM2(K = 3), 100 replications in 10 bins: the CI variant. When written, the two took 31 s of
+/// CPU together on one thread (independence about four times laplace-is's share), all eight
+/// p-values between 0.15 and 0.86, every control below 10⁻¹⁵. The threshold is BM1's, 0.01 split over the four quantities: the
+/// seeds are fixed, so the test cannot flake, but a correct sampler whose draws change (a
+/// changed kernel, another seed) fails it one time in a hundred; the controls show that an
+/// error of one sd, or a width three times too small, fails by more than ten orders of
+/// magnitude, so a stricter level would buy nothing here.
+#[test]
+fn independence_ranks_the_truth_uniformly_on_bm2_k3_in_100_replications() {
+    calibration(&bm2_k3(), 100, 10, SamplerKind::Independence);
+}
+
+#[test]
+fn laplace_is_ranks_the_truth_uniformly_on_bm2_k3_in_100_replications() {
+    calibration(&bm2_k3(), 100, 10, SamplerKind::LaplaceIs);
+}
+
+/// 1000 replications of each Laplace sampler on BM2(K = 3) in 20 bins; the report is written
+/// to papers/laplace-samplers/sbc_bm2_k3.txt. When written, this did not finish: after 26 min
+/// of CPU on one thread (40 min under load) it was still in the independence replications,
+/// which at the CI variant's rate (100 in about 25 s) would have taken four minutes — some
+/// replication's chain must need orders of magnitude more draws to mix, as with c_g and J
+/// calibrated (see [`bm2_k3`]); not yet found which.
+#[test]
+#[ignore]
+fn on_bm2_k3_the_laplace_samplers_rank_the_truth_uniformly_in_1000_replications() {
+    let mut report = String::new();
+    for sampler in [SamplerKind::Independence, SamplerKind::LaplaceIs] {
+        report.push_str(&calibration(&bm2_k3(), 1000, 20, sampler));
+    }
+    write_report(
+        "sbc_bm2_k3.txt",
+        "cargo test --release --test sbc -- --ignored on_bm2_k3_the_laplace_samplers",
+        &report,
+    );
+}
+
+/// laplace-is alone on BM2(K = 3), 1000 replications in 20 bins, written to
+/// papers/laplace-samplers/sbc_bm2_k3_laplace_is.txt: a few minutes, where the run of both
+/// samplers above is dominated by the independence chains that need long runs to mix.
+#[test]
+#[ignore]
+fn on_bm2_k3_laplace_is_ranks_the_truth_uniformly_in_1000_replications() {
+    let report = calibration(&bm2_k3(), 1000, 20, SamplerKind::LaplaceIs);
+    write_report(
+        "sbc_bm2_k3_laplace_is.txt",
+        "cargo test --release --test sbc -- --ignored on_bm2_k3_laplace_is",
+        &report,
+    );
 }
