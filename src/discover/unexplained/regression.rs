@@ -73,9 +73,13 @@ pub struct Explained {
 
 /// The gain alone, for searches over many alternatives.
 pub fn gain(y: &DVector<f64>, b: &DMatrix<f64>) -> f64 {
-    let h = b.transpose() * y;
-    let (g_inv, _) = pseudo_inverse(b.transpose() * b);
-    0.5 * h.dot(&(&g_inv * &h))
+    gain_from_normal_equations(&(b.transpose() * y), b.transpose() * b)
+}
+
+/// [`gain`] from its normal equations: ½·hᵀG⁺h with h = Bᵀy and G = BᵀB.
+pub fn gain_from_normal_equations(h: &DVector<f64>, g: DMatrix<f64>) -> f64 {
+    let (g_inv, _) = pseudo_inverse(g);
+    0.5 * h.dot(&(&g_inv * h))
 }
 
 /// The sds of the coefficients of B̃'s columns (σ = 1 in whitened units): √diag((B̃ᵀB̃)⁺).
