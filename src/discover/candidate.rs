@@ -14,6 +14,8 @@
 
 use std::collections::BTreeMap;
 
+use rayon::prelude::*;
+
 use crate::bayes::{CalibrationPosterior, ModelSettings};
 use crate::density::LogDensity;
 use crate::error::Error;
@@ -290,10 +292,18 @@ fn best_map(
             .map(|(_, s)| s)
             .collect();
     }
+    // The starts are independent searches: run side by side (each on its own copy of the
+    // posterior, whose caches are then not shared) and compared in their order, so the pick
+    // is the sequential one whatever the threads. On a long record a fit's two starts were
+    // its critical path: 18 s each for load_step beside Coulomb friction on EMPS.
+    let searched: Vec<_> = starts
+        .par_iter()
+        .map(|s| find_map(&mut posterior.clone(), s, &MapSettings::ranking()))
+        .collect();
     let mut best: Option<MapEstimate> = None;
     let mut last_error = None;
-    for s in starts {
-        match find_map(posterior, &s, &MapSettings::ranking()) {
+    for r in searched {
+        match r {
             Ok(map) => {
                 if best
                     .as_ref()

@@ -9,7 +9,7 @@ use crate::study::Problem;
 
 use super::candidate::{Candidate, fit_candidate, fit_candidate_started};
 use super::confirm::importance_evidence;
-use super::settings::{EVIDENCE_THRESHOLD, MAX_TERMS};
+use super::settings::{EVIDENCE_THRESHOLD, MAX_TERMS, uses_laplace};
 use super::state::records_reverse;
 use super::unexplained::{DYNAMIC, StepScreen, dynamic_starts};
 
@@ -110,6 +110,7 @@ pub fn forward_selection(
         });
     }
     let mut current = best.clone();
+    let long = uses_laplace(problem);
     // On records that never reverse, Coulomb friction and a load torque are one torque (they
     // differ only in the first milliseconds of a start-up): both at once is a model whose two
     // levels trade freely, and its MAP a degenerate one (T_c and T_0 of ten times their size
@@ -123,10 +124,11 @@ pub fn forward_selection(
             )
     };
     while current.added.len() < MAX_TERMS {
-        // Beside a dynamic term every fit is dear: candidates the first-order screen rules out
-        // are not fitted (`StepScreen`).
+        // Beside a dynamic term, or on a record long enough to be fitted by the Laplace
+        // approximation (each solve through 5 000 samples or more), every fit is dear:
+        // candidates the first-order screen rules out are not fitted (`StepScreen`).
         let dear = |name: &str| {
-            current
+            long || current
                 .added
                 .iter()
                 .chain(std::iter::once(&name.to_string()))
