@@ -80,6 +80,14 @@ pub trait LogDensity {
     fn solves(&self) -> SolveCount {
         SolveCount::default()
     }
+
+    /// Whether many of the coordinates enter the likelihood linearly beside a few scales (a
+    /// discrepancy's coefficients beside the noise scales). Marginalising many such
+    /// coordinates moves the scales' marginal away from the joint mode, the offset that
+    /// `laplace-is`'s recentring warm-up is for; without them it has nothing to correct.
+    fn has_linear_coefficients(&self) -> bool {
+        false
+    }
 }
 
 /// ODE solves made: plain f64 solves, and dual-number solves with the number of derivative
@@ -206,6 +214,9 @@ impl<P: LogDensity> LogDensity for Counted<P> {
     }
     fn solves(&self) -> SolveCount {
         self.inner.solves()
+    }
+    fn has_linear_coefficients(&self) -> bool {
+        self.inner.has_linear_coefficients()
     }
 }
 

@@ -488,7 +488,7 @@ fn the_laplace_samplers_rank_the_truth_uniformly_in_1000_replications() {
     }
     write_report(
         "sbc_bm1.txt",
-        "cargo test --release --test sbc -- --ignored the_laplace_samplers",
+        "cargo test --release --test sbc -- --ignored --exact the_laplace_samplers_rank_the_truth_uniformly_in_1000_replications",
         &report,
     );
 }

@@ -143,18 +143,10 @@ fn importance_or_sampler(
         sampler: SamplerKind::LaplaceIs,
         fallback: true,
         fallback_above: KHAT_GOOD,
-        // The run's warm-up is NUTS's; importance sampling's is its own recentring, whose reason
-        // (the noise scales' marginal drifting above their joint mode under many discrepancy
-        // coefficients) exists only in BM2. Without coefficients the amended models' terms near
-        // their bounds make the marginals skewed, and moving a symmetric proposal to their mean
-        // thins the mode's side: on dev case03's after-fit k̂ rose from 0.52–0.68 to 0.65–0.79
-        // over six seeds. So BM1 keeps the MAP's proposal.
+        // The run's warm-up is NUTS's; importance sampling's is its own recentring (BM2 fits
+        // only: see `pipeline::importance`).
         chain: crate::sampler::ChainSettings {
-            warmup: if posterior.discrepancy_description().is_some() {
-                default_warmup(SamplerKind::LaplaceIs, run.metric_adaptation)
-            } else {
-                0
-            },
+            warmup: default_warmup(SamplerKind::LaplaceIs, run.metric_adaptation),
             ..run.chain.clone()
         },
         ..run.clone()

@@ -33,11 +33,21 @@ pub(super) fn laplace_is<P: Fittable>(
     let proposal = LaplaceProposal::new(&map.x, &map.hessian)
         .and_then(|p| p.with_shape(IS_SHAPE.0, IS_SHAPE.1))
         .map_err(Error::Numerical)?;
+    // The recentring corrects the offset of the scales' marginal from the joint mode under
+    // many linear coefficients (BM2). Without them (BM1) the marginals that are off their mode
+    // are skewed ones — a term near its bound — where a symmetric proposal moved to the mean
+    // thins the mode's side: 1000 SBC replications on BM1 put k̂ above 0.5 in 43 with it
+    // against 8 without, and dev case 03's after-fit from 0.52–0.68 to 0.65–0.79 (six seeds).
+    let recentring = if posterior.has_linear_coefficients() {
+        settings.chain.warmup
+    } else {
+        0
+    };
     let work = || {
         importance_sample(
             &proposal,
             settings.chains,
-            settings.chain.warmup,
+            recentring,
             settings.chain.draws,
             settings.seed,
             |_| Ok::<_, DensityError>(posterior.clone()),

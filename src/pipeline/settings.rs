@@ -122,8 +122,9 @@ pub enum MetricAdaptation {
 /// paper's, at a tenth of 1000 draws. Everything else keeps Stan's 1000: the windows need it
 /// to estimate a metric, and MALA's step-size search is noisier. The independence sampler
 /// tries each of its proposal shapes for 40 transitions; importance sampling spends a quarter of
-/// its default 1000 draws per chain recentring its proposal (`sampler::importance`), and those
-/// draws are weighed into the result, not discarded.
+/// its default 1000 draws per chain recentring its proposal (`sampler::importance`; on BM2
+/// only, see `pipeline::importance`), and those draws are weighed into the result, not
+/// discarded.
 pub fn default_warmup(sampler: SamplerKind, metric: MetricAdaptation) -> usize {
     match sampler {
         SamplerKind::Independence => crate::sampler::independence::INDEPENDENCE_WARMUP,

@@ -183,6 +183,11 @@ impl LogDensity for CalibrationPosterior {
     fn blocks(&self) -> Vec<Range<usize>> {
         self.blocks.clone()
     }
+
+    /// BM2: the discrepancy's coefficients.
+    fn has_linear_coefficients(&self) -> bool {
+        self.discrepancy_description().is_some()
+    }
 }
 
 impl StartingPoint for CalibrationPosterior {
