@@ -139,12 +139,7 @@ impl LaplaceProposal {
     /// The normalised log density at `x`.
     pub fn log_density(&self, x: &[f64]) -> f64 {
         let d = self.dim() as f64;
-        let r = DVector::from_iterator(
-            self.dim(),
-            x.iter().zip(self.mean.iter()).map(|(a, m)| a - m),
-        );
-        let w = &self.l_t * r;
-        let q = w.norm_squared() / (self.scale * self.scale);
+        let q = self.whiten(x).norm_squared() / (self.scale * self.scale);
         let log_jacobian = self.half_log_det - d * self.scale.ln();
         if self.df.is_finite() {
             let nu = self.df;

@@ -63,56 +63,27 @@ fn columns(ctx: &Context, c: usize, f: f64, decay: Option<f64>) -> DMatrix<f64> 
 /// (decaying at λ) a pair after each of `steps`, zero before it and once its envelope is below
 /// 10⁻⁴.
 fn channel_columns(times: &[f64], steps: &[f64], f: f64, decay: Option<f64>) -> DMatrix<f64> {
-    let n = times.len();
-    let w = 2.0 * PI * f;
-    match decay {
-        None => {
-            let mut b = DMatrix::zeros(n, 2);
-            for (i, &t) in times.iter().enumerate() {
-                let (s, co) = (w * t).sin_cos();
-                b[(i, 0)] = co;
-                b[(i, 1)] = s;
-            }
-            b
-        }
-        Some(l) => {
-            let mut b = DMatrix::zeros(n, 2 * steps.len());
-            for (k, &ts) in steps.iter().enumerate() {
-                for (i, &t) in times.iter().enumerate() {
-                    if t < ts {
-                        continue;
-                    }
-                    let tau = t - ts;
-                    let envelope = (-l * tau).exp();
-                    if envelope < 1e-4 {
-                        break;
-                    }
-                    let (s, co) = (w * tau).sin_cos();
-                    b[(i, 2 * k)] = envelope * co;
-                    b[(i, 2 * k + 1)] = envelope * s;
-                }
-            }
-            b
+    let windows = windows(times, steps, f, decay);
+    let mut b = DMatrix::zeros(times.len(), 2 * windows.len());
+    for (k, (start, values)) in windows.iter().enumerate() {
+        for (i, &(co, s)) in values.iter().enumerate() {
+            b[(start + i, 2 * k)] = co;
+            b[(start + i, 2 * k + 1)] = s;
         }
     }
+    b
 }
 
-/// The quick gain used by the search: channel c's projected residual regressed on the
-/// unprojected columns (the exact score is computed once, at the end). The same regression as
-/// [`gain`] on `columns`' rows of channel c, summed over where each column is nonzero only: a
-/// ringing column vanishes before its step and after its envelope falls below 10⁻⁴, and on a
-/// long record the dense B̃ᵀB̃ over every row was most of a diagnosis's time.
-fn quick_gain(ctx: &Context, c: usize, f: f64, decay: Option<f64>) -> f64 {
-    let n = ctx.n;
-    let y = &ctx.y_perp.as_slice()[c * n..(c + 1) * n];
-    windowed_gain(&ctx.times, &ctx.steps, y, f, decay)
-}
-
-/// [`gain`] of y on [`channel_columns`], summed over each column's nonzero window only.
-fn windowed_gain(times: &[f64], steps: &[f64], y: &[f64], f: f64, decay: Option<f64>) -> f64 {
+/// [`channel_columns`]' column pairs where they are nonzero: each pair's first row and its
+/// (cos, sin) values from there.
+fn windows(
+    times: &[f64],
+    steps: &[f64],
+    f: f64,
+    decay: Option<f64>,
+) -> Vec<(usize, Vec<(f64, f64)>)> {
     let w = 2.0 * PI * f;
-    // Each column pair (cos, sin) as its first row and its values from there.
-    let windows: Vec<(usize, Vec<(f64, f64)>)> = match decay {
+    match decay {
         None => vec![(
             0,
             times
@@ -140,7 +111,23 @@ fn windowed_gain(times: &[f64], steps: &[f64], y: &[f64], f: f64, decay: Option<
                 (start, values)
             })
             .collect(),
-    };
+    }
+}
+
+/// The quick gain used by the search: channel c's projected residual regressed on the
+/// unprojected columns (the exact score is computed once, at the end). The same regression as
+/// [`gain`] on `columns`' rows of channel c, summed over where each column is nonzero only: a
+/// ringing column vanishes before its step and after its envelope falls below 10⁻⁴, and on a
+/// long record the dense B̃ᵀB̃ over every row was most of a diagnosis's time.
+fn quick_gain(ctx: &Context, c: usize, f: f64, decay: Option<f64>) -> f64 {
+    let n = ctx.n;
+    let y = &ctx.y_perp.as_slice()[c * n..(c + 1) * n];
+    windowed_gain(&ctx.times, &ctx.steps, y, f, decay)
+}
+
+/// [`gain`] of y on [`channel_columns`], summed over each column's nonzero window only.
+fn windowed_gain(times: &[f64], steps: &[f64], y: &[f64], f: f64, decay: Option<f64>) -> f64 {
+    let windows = windows(times, steps, f, decay);
     let k = 2 * windows.len();
     let mut h = DVector::zeros(k);
     let mut g = DMatrix::zeros(k, k);
