@@ -135,7 +135,7 @@ where
             .collect::<Result<_, _>>()?;
         components[0].1 += defensive * chains;
         if n > defensive {
-            components.push((current.clone(), (n - defensive) * chains));
+            add_component(&mut components, &current, (n - defensive) * chains);
         }
         rounds.push(blocks);
         if rounds.len() <= per_round.len() {
@@ -207,6 +207,17 @@ where
         psis: smoothed,
         centre: current.mean().to_vec(),
     })
+}
+
+/// `n` more proposals from `q` in the mixture, counted with an equal component where there is
+/// one (a round whose centre did not move; the rounds share the Laplace scale matrix, so their
+/// centres tell them apart): the mixture holds each distinct proposal once, and a recentring
+/// that moves nothing weighs every draw exactly as no recentring would.
+fn add_component(components: &mut Vec<(LaplaceProposal, usize)>, q: &LaplaceProposal, n: usize) {
+    match components.iter_mut().find(|(c, _)| c.mean() == q.mean()) {
+        Some((_, count)) => *count += n,
+        None => components.push((q.clone(), n)),
+    }
 }
 
 /// log π(x) − log Σᵣ (nᵣ/N) qᵣ(x) for every proposal so far: each weighed against the mixture of
