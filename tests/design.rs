@@ -200,13 +200,13 @@ fn bad_options_get_one_clear_error_and_write_nothing() {
     let out = dir.join("design");
     let model = fixture("motor.toml");
     let diagnosis = fixture("diagnosis.json");
-    let run = |extra: &[&str]| {
-        let mut args = vec![
-            "design",
-            "--model",
-            model.to_str().unwrap(),
-            "--diagnosis",
-            diagnosis.to_str().unwrap(),
+    // A quick design of `model` (with the fixture's diagnosis unless `diagnosed` is false).
+    let run_on = |model: &Path, diagnosed: bool, extra: &[&str]| {
+        let mut args = vec!["design", "--model", model.to_str().unwrap()];
+        if diagnosed {
+            args.extend(["--diagnosis", diagnosis.to_str().unwrap()]);
+        }
+        args.extend([
             "--rate",
             "400",
             "--segments",
@@ -217,10 +217,11 @@ fn bad_options_get_one_clear_error_and_write_nothing() {
             "2",
             "--out",
             out.to_str().unwrap(),
-        ];
+        ]);
         args.extend_from_slice(extra);
         motorcal(&args)
     };
+    let run = |extra: &[&str]| run_on(&model, true, extra);
     let limits = "U=±24,I=±300,omega=±3000";
     let o = run(&["--duration", "0.02", "--limits", limits]);
     one_error_line(&o, &["--duration", "8 samples", "ten"]);
@@ -244,36 +245,14 @@ fn bad_options_get_one_clear_error_and_write_nothing() {
     one_error_line(&o, &["--limits", "all three"]);
     // A drive base's input is a reference (a current command), not a voltage to search.
     let hsm150 = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/hsm150/model.toml");
-    let o = motorcal(&[
-        "design",
-        "--model",
-        hsm150.to_str().unwrap(),
-        "--pin",
-        "J",
-        "--duration",
-        "0.05",
-        "--rate",
-        "400",
-        "--limits",
-        limits,
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = run_on(
+        &hsm150,
+        false,
+        &["--pin", "J", "--duration", "0.05", "--limits", limits],
+    );
     one_error_line(&o, &["reference", "voltage-driven"]);
     // Neither candidates nor a diagnosis to take them from.
-    let o = motorcal(&[
-        "design",
-        "--model",
-        model.to_str().unwrap(),
-        "--duration",
-        "0.05",
-        "--rate",
-        "400",
-        "--limits",
-        limits,
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = run_on(&model, false, &["--duration", "0.05", "--limits", limits]);
     one_error_line(&o, &["--separate", "--diagnosis"]);
     assert!(!out.exists());
 }
