@@ -295,7 +295,7 @@ fn best_map(
     // The starts are independent searches: run side by side (each on its own copy of the
     // posterior, whose caches are then not shared) and compared in their order, so the pick
     // is the sequential one whatever the threads. On a long record a fit's two starts were
-    // its critical path: 18 s each for load_step beside Coulomb friction on EMPS.
+    // a forward step's critical path (load_step beside Coulomb friction on EMPS).
     let searched: Vec<_> = starts
         .par_iter()
         .map(|s| find_map(&mut posterior.clone(), s, &MapSettings::ranking()))

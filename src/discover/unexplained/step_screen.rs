@@ -1,7 +1,7 @@
 //! A forward step's screen where fits are dear: before a candidate is fitted beside a model
 //! that holds a dynamic term (every solve through a resonance's or a filter's states costs
 //! seconds, and a step fits every candidate), or on a record of more than 5 000 samples (each
-//! solve as dear: on EMPS's 24 841 a forward step's fits were 56 s of CPU), its gain is
+//! solve as dear: on EMPS's 24 841 samples the forward steps were most of a diagnosis), its gain is
 //! estimated to first order, as the
 //! verdict estimates an alternative's (`regression`): the whitened residual of the current
 //! model regressed on the candidate's sensitivities at its absent value, the current model's
