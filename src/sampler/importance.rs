@@ -6,8 +6,9 @@
 //! worth — the resampled draws look independent and would overstate it.
 //!
 //! The MAP is the joint posterior's mode, not its mean: with many coefficients beside them the
-//! noise scales' marginal sits above their joint mode (at K = 20 on the paper's data the weighted
-//! mean of log σ lies 0.7 Laplace standard deviations above the MAP), and a proposal off centre
+//! noise scales' marginal sits above their joint mode (at K = 20 on the paper's data `motorcal
+//! bench --k 20 --samplers laplace-is` finds 1408 effective draws with the recentring and 618
+//! with `--warmup 0`), and a proposal off centre
 //! by δ in whitened units loses about a factor e^{-|δ|²} of its effective draws. So the
 //! warm-up recentres the proposal in rounds: each round's draws are weighed, the weighted mean
 //! is taken in whitened coordinates, and only the coordinates whose shift exceeds twice its
