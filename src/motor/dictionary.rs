@@ -8,7 +8,7 @@
 use super::{Magnitudes, Scalar};
 
 /// The functions, in the order of the law's parameters (within each balance).
-pub const FUNCTIONS: [&str; 17] = [
+pub const FUNCTIONS: [&str; 18] = [
     "omega",
     "omega*|omega|",
     "omega^3",
@@ -26,6 +26,7 @@ pub const FUNCTIONS: [&str; 17] = [
     "cos(theta)",
     "sin(2*pi*f*t)",
     "cos(2*pi*f*t)",
+    "U*charge",
 ];
 
 /// How many functions the dictionary holds.
@@ -41,11 +42,17 @@ pub const HEAT: usize = 11;
 pub const TIME: usize = 12;
 const SIN_THETA: usize = 13;
 const COS_THETA: usize = 14;
+/// The periodic functions of time, whose frequency is a setting.
+pub const PERIODIC: [usize; 2] = [15, 16];
+/// The input scaled by the charge drawn: a PWM drive's supply that sags as its battery
+/// discharges applies U·(1 − κ·q), which on a record whose input changes sign or level is not
+/// the charge alone.
+pub const U_CHARGE: usize = 17;
 
 /// The state a function needs integrated (0: charge, 1: heat, 2: θ), if any.
 pub fn state_of(function: usize) -> Option<usize> {
     match function {
-        CHARGE => Some(0),
+        CHARGE | U_CHARGE => Some(0),
         HEAT => Some(1),
         SIN_THETA | COS_THETA => Some(2),
         _ => None,
@@ -97,6 +104,7 @@ pub fn value<D: Scalar>(f: usize, x: &Point<D>, s: &Shapes) -> D {
         COS_THETA => x.theta.cos(),
         15 => D::from(phase.sin()),
         16 => D::from(phase.cos()),
+        U_CHARGE => x.voltage * x.charge,
         _ => unreachable!("the dictionary has {N_FUNCTIONS} functions"),
     }
 }
@@ -112,6 +120,7 @@ pub fn typical_size(f: usize, m: &Magnitudes) -> f64 {
         7 => m.current * m.current,
         9 => m.voltage,
         CHARGE => m.current * m.duration,
+        U_CHARGE => m.voltage * m.current * m.duration,
         // R·I² over the record: U·I at stall.
         HEAT => m.voltage * m.current * m.duration,
         TIME => m.duration,
@@ -129,6 +138,7 @@ pub fn units(f: usize) -> (&'static str, &'static str) {
         7 => ("N·m/A²", "V/A²"),
         9 => ("N·m/V", "1"),
         CHARGE => ("N·m/(A·s)", "V/(A·s)"),
+        U_CHARGE => ("N·m/(V·A·s)", "1/(A·s)"),
         HEAT => ("N·m/J", "V/J"),
         TIME => ("N·m/s", "V/s"),
         _ => ("N·m", "V"),

@@ -15,8 +15,9 @@
 //! ranking pays it; ln(columns tried) pays for having picked the best of that many (under the
 //! model each gain is ½χ²₁, and the largest of m exceeds a level about m times as often as one
 //! does, i.e. costs ln m nats); the threshold is the ranking's margin, for the ranking's
-//! reason. With N = 1002 and the 20 columns of a balance the first column needs a gain of
-//! 3.45 + 3.00 + 2 = 8.45 nats: 20·P(χ²₁ > 16.9) ≈ 0.1% per balance on a null record. The fingerprint's score is
+//! reason. With N = 1002 and the 21 columns of a balance the first column needs a gain of
+//! 3.45 + 3.04 + 2 = 8.49 nats: 21·P(χ²₁ > 17.0) ≈ 0.1% per balance on a null record. The
+//! fingerprint's score is
 //! the gain less the first two prices of each column taken (as the other alternatives' scores
 //! are their gain less ½·ln N per degree and the logarithm of their grid); the verdict's
 //! threshold then applies to it as to them.
@@ -47,9 +48,8 @@ const STRIBECK_SHARES: [f64; 6] = [0.004, 0.008, 0.016, 0.032, 0.064, 0.128];
 /// At most this many functions per balance: a law longer than that is no longer a fingerprint.
 const MAX_FUNCTIONS: usize = 4;
 
-/// The dictionary's index of the Stribeck function, and of the first periodic one.
+/// The dictionary's index of the Stribeck function.
 const STRIBECK: usize = 4;
-const PERIODIC: usize = 15;
 
 /// A column of the regression: a function (dictionary index) and the Stribeck speed it has.
 struct Column {
@@ -142,7 +142,9 @@ pub(super) fn fingerprints(
     let Some(Term::Law(law)) = Term::named("law") else {
         return Ok(Vec::new());
     };
-    let plain: Vec<usize> = (0..PERIODIC).filter(|&f| f != STRIBECK).collect();
+    let plain: Vec<usize> = (0..N_FUNCTIONS)
+        .filter(|&f| f != STRIBECK && !dictionary::PERIODIC.contains(&f))
+        .collect();
     let mut columns: Vec<Column> = Vec::new();
     let mut blocks: Vec<DMatrix<f64>> = Vec::new();
     // Torque columns then voltage columns, per block: block j holds the balance-major keys.
@@ -238,7 +240,7 @@ fn select(
     let balance = dictionary::BALANCES[balance].to_string();
     let drift = |f: &LawFunction| match f.name.as_str() {
         "t" => Some("time"),
-        "charge" => Some("charge"),
+        "charge" | "U*charge" => Some("charge"),
         "heat" => Some("heat"),
         _ => None,
     };

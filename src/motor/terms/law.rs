@@ -104,6 +104,7 @@ impl PhysicsTerm for Law {
         14 "cos(theta)" "N·m" "V",
         15 "sin(2*pi*f*t)" "N·m" "V",
         16 "cos(2*pi*f*t)" "N·m" "V",
+        17 "U*charge" "N·m/(V·A·s)" "1/(A·s)",
     );
     const SETTINGS: &'static [TermSetting] = &[
         TermSetting {
