@@ -1,6 +1,6 @@
 //! Discovering the law: effects no library term holds, simulated outside the crate's model by
-//! the independent RK4 integrator of `examples/beyond_library_cases.rs` (seeds 510012 and
-//! 510015 of `--per-effect 2 --seed-base 510000`, the answer beside each recording), leave a
+//! the independent RK4 integrator of `examples/beyond_library_cases.rs` (seeds 510012, 510013
+//! and 510015 of `--per-effect 2 --seed-base 510000`, the answer beside each recording), leave a
 //! state fingerprint; the law term written from it is fitted, taken by the ranking's threshold,
 //! and holds the true functions with coefficients near the truth, leaving nothing. Null
 //! records of the crate's own generator, with every candidate allowed, discover nothing.
@@ -103,6 +103,55 @@ fn a_ripple_once_per_revolution_is_discovered_in_the_angle() {
         .sqrt();
     assert!(within(amplitude, a, 0.3), "{amplitude} vs {a}");
     assert!(d.unexplained.is_none(), "{:?}", d.unexplained);
+}
+
+/// A PWM drive whose battery sags with the charge drawn applies U·(1 − κ·q), q = ∫|I|dt. On a
+/// record that steps and reverses, three library terms together stand in for it (a back-EMF
+/// constant, asymmetric friction, a current offset) and leave the verdict nothing; the law the
+/// model as given asks for, −κ·U·q in the voltage balance, fitted in their place, beats them.
+#[test]
+fn a_supply_sagging_with_the_charge_is_discovered_in_place_of_library_terms_standing_in() {
+    let (problem, answer) = fixture("sagging_supply-510013");
+    let kappa = truth_value(&answer, "kappa");
+    let d = diagnose(&problem);
+    let law = d.discovered.expect("a law is discovered");
+    assert_eq!(law.balance, "voltage");
+    let names: Vec<&str> = law.functions.iter().map(|f| f.name.as_str()).collect();
+    assert_eq!(names, ["U*charge"]);
+    let f = &law.functions[0];
+    assert!(
+        within(f.coefficient, -kappa, 0.3),
+        "{} vs {}",
+        f.coefficient,
+        -kappa
+    );
+    assert_eq!(d.selected_set, ["law"]);
+}
+
+/// Where a library term holds the effect, the law the model as given asks for is that term
+/// written in the dictionary (a back-EMF constant is c·ω in the voltage balance): fitted in
+/// its place it ties, and the library's name stands.
+#[test]
+fn a_library_effect_is_named_by_the_library_not_rewritten_as_a_law() {
+    for (effect, seed) in [("back_emf_constant", 21), ("viscous_friction", 22)] {
+        let case = make_case(&CaseOptions {
+            effects: vec![effect.into()],
+            magnitude: None,
+            input: InputProfile::Reversal,
+            seed,
+            conceal: true,
+        })
+        .unwrap();
+        let problem = Problem {
+            label: effect.into(),
+            recordings: vec![case.recording],
+            model: case.nominal,
+            reference: None,
+        };
+        let d = diagnose(&problem);
+        assert_eq!(d.selected, effect, "seed {seed}");
+        assert!(d.discovered.is_none(), "seed {seed}");
+    }
 }
 
 /// Null records, every candidate allowed (the law among what may be added): nothing is

@@ -26,7 +26,7 @@ use super::settings::{
 };
 use super::state::{StateFingerprint, fingerprint, reading};
 use super::ties::separating_input;
-use super::unexplained::{Unexplained, unexplained};
+use super::unexplained::{Unexplained, law_proposals, unexplained};
 
 #[derive(Clone, Debug, Serialize)]
 pub struct RankEntry {
@@ -208,9 +208,30 @@ pub fn assemble(
     } else {
         Some(&[])
     };
-    if let Some(verdict) = &left
-        && let Some(fit) = fit_named_terms(problem, verdict, &selected_fit, &none, allowed)?
-    {
+    // What the verdict names is fitted beside the selected terms and alone (a library term
+    // selected for a delay absorbs part of it and is then dead weight beside it); a law the
+    // model as given asks for, alone, in place of the terms that stand in for it.
+    let mut bases = vec![&selected_fit];
+    if !selected_fit.added.is_empty() {
+        bases.push(&none);
+    }
+    let proposals = law_proposals(problem, &selected_fit, &none)?;
+    let named_fit = match &left {
+        Some(verdict) => fit_named_terms(
+            problem,
+            std::iter::once(&verdict.fingerprint).chain(&verdict.considered),
+            &bases,
+            &selected_fit,
+            allowed,
+        )?,
+        None => None,
+    };
+    let proposed_fit = fit_named_terms(problem, &proposals, &[&none], &selected_fit, allowed)?;
+    let best = [named_fit, proposed_fit]
+        .into_iter()
+        .flatten()
+        .max_by(|a, b| a.score.total_cmp(&b.score));
+    if let Some(fit) = best {
         found = discovered(&fit, fit.score - selected_fit.score);
         selected_set = fit.added.clone();
         selected_fit = fit;

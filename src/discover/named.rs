@@ -23,7 +23,7 @@ use crate::study::Problem;
 
 use super::candidate::{Candidate, Starts, fit_candidate_started};
 use super::settings::EVIDENCE_THRESHOLD;
-use super::unexplained::{EquationTerm, Fingerprint, Unexplained, equation_with};
+use super::unexplained::{EquationTerm, Fingerprint, equation_with};
 
 /// The term a fingerprint names, with its settings and the parameter values it starts at.
 #[derive(Clone, Debug, PartialEq)]
@@ -139,29 +139,26 @@ fn fit_named(problem: &Problem, with: &Candidate, named: &NamedTerm) -> Result<C
     fit_candidate_started(problem, &added, Some(with), &starts)
 }
 
-/// The best fit of a term the verdict's fingerprints name (every kind that cleared the
-/// threshold on its own, not only the leader: the fits, not the linearised scores, decide), when it beats `selected` by more than the threshold. Where the user named
-/// the candidates (`allowed`), only those may be added: the list says what the diagnosis may
-/// add to the model, whichever way it finds them.
-pub fn fit_named_terms(
+/// The best fit of a term the fingerprints name (every kind that cleared the threshold on its
+/// own, not only the leader: the fits, not the linearised scores, decide), each fitted beside
+/// every one of `bases`, when it beats `selected` by more than the threshold. Where the user
+/// named the candidates (`allowed`), only those may be added: the list says what the diagnosis
+/// may add to the model, whichever way it finds them.
+pub fn fit_named_terms<'a>(
     problem: &Problem,
-    left: &Unexplained,
+    fingerprints: impl IntoIterator<Item = &'a Fingerprint>,
+    bases: &[&Candidate],
     selected: &Candidate,
-    none: &Candidate,
     allowed: Option<&[String]>,
 ) -> Result<Option<Candidate>, Error> {
     let mut named: Vec<NamedTerm> = Vec::new();
-    for f in std::iter::once(&left.fingerprint).chain(&left.considered) {
+    for f in fingerprints {
         if let Some(n) = named_term(problem, f)
-            && !named.iter().any(|m| m.term.name() == n.term.name())
+            && !named.iter().any(|m| m.same_term(&n))
             && allowed.is_none_or(|a| a.iter().any(|c| c == n.term.name()))
         {
             named.push(n);
         }
-    }
-    let mut bases = vec![selected];
-    if !selected.added.is_empty() {
-        bases.push(none);
     }
     let jobs: Vec<(&Candidate, &NamedTerm)> = named
         .iter()
@@ -177,6 +174,17 @@ pub fn fit_named_terms(
         .into_iter()
         .filter(|f| f.score - selected.score > EVIDENCE_THRESHOLD)
         .max_by(|a, b| a.score.total_cmp(&b.score)))
+}
+
+impl NamedTerm {
+    /// Two fingerprints name the same term where its name is the same (the first, the
+    /// stronger, gives the start), except laws, which are told apart by their functions.
+    fn same_term(&self, other: &NamedTerm) -> bool {
+        match (&self.term, &other.term) {
+            (Term::Law(a), Term::Law(b)) => a == b,
+            (a, b) => a.name() == b.name(),
+        }
+    }
 }
 
 /// One function of a discovered law: its coefficient at the MAP and the 95% interval of the

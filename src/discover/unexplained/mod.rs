@@ -410,6 +410,32 @@ fn spans(ctx: &Context, c: usize, e: &Explained) -> Vec<Span> {
     out
 }
 
+/// The laws the model as given asks for: its state and drift fingerprints (functions chosen by
+/// evidence against the model without terms), whatever the selected terms gained. A law whose
+/// effect is large is underestimated by its first-order gain (its sensitivities are taken at
+/// zero coefficients), so the verdict, which compares that gain with what the selected terms
+/// gained, can miss a law that fits better than a library term standing in for it (a supply
+/// sagging with the charge taken as three library terms); these are fitted through the ODE
+/// and the fits decide (`named::fit_named_terms`). None where nothing was selected: the
+/// verdict holds the same fingerprints then.
+pub fn law_proposals(
+    problem: &Problem,
+    selected: &Candidate,
+    none: &Candidate,
+) -> Result<Vec<Fingerprint>, Error> {
+    if problem.recordings.is_empty() || selected.added.is_empty() {
+        return Ok(Vec::new());
+    }
+    let ctx = Context::of(problem, none, 0)?;
+    if ctx.n < 20 {
+        return Ok(Vec::new());
+    }
+    Ok(state::fingerprints(none, &ctx, 0.0)?
+        .into_iter()
+        .map(|e| e.fingerprint)
+        .collect())
+}
+
 /// The verdict on the first record: `None` when the selected model leaves nothing a generic
 /// alternative finds, by more than the threshold, on it or on the model as given.
 pub fn unexplained(
