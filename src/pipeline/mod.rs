@@ -36,6 +36,7 @@ use crate::sampler::{Adaptation, ChainOutput, Kernel, RunControl, run_chains_unt
 use crate::error::{Error, InputError};
 
 pub mod cost;
+mod fallback;
 mod importance;
 pub mod settings;
 pub use crate::sampler::PhaseCost;
