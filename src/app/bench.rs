@@ -184,7 +184,7 @@ fn format_record(r: &BenchRecord) -> String {
     ) + &khat_note(r)
 }
 
-/// laplace-is's k̂ and whether it fell back to NUTS; nothing for the MCMC samplers.
+/// The Laplace samplers' k̂ and whether they fell back to NUTS; nothing for the others.
 fn khat_note(r: &BenchRecord) -> String {
     match r.khat {
         Some(k) if r.fell_back => format!("  k̂ {k:.3} (fell back to NUTS)"),

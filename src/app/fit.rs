@@ -96,7 +96,7 @@ pub struct RunArgs {
     /// HMC/NUTS: start from a saved adaptation and skip adapting (use with a short --warmup).
     #[arg(long)]
     pub load_adaptation: Option<PathBuf>,
-    /// laplace-is: keep the importance sampling even when k̂ > 0.7 says the Laplace
+    /// laplace-is, independence: keep the Laplace sampler even when k̂ > 0.7 says the Laplace
     /// approximation cannot be trusted (default: fall back to NUTS).
     #[arg(long)]
     pub no_fallback: bool,
@@ -180,9 +180,10 @@ pub struct FitReport {
     pub max_rhat: Option<f64>,
     pub min_ess_bulk: Option<f64>,
     pub divergences: Option<usize>,
-    /// laplace-is: the Pareto shape k̂ of its importance weights (null for the MCMC samplers).
+    /// laplace-is, independence: the Pareto shape k̂ of the importance weights of their
+    /// proposals (independence: its warm-up's; null for the other samplers).
     pub khat: Option<f64>,
-    /// laplace-is: k̂ > 0.7 and NUTS drew instead.
+    /// laplace-is, independence: k̂ > 0.7 and NUTS drew instead.
     pub fell_back: bool,
     pub wall_seconds: Option<f64>,
     pub outputs: Vec<String>,

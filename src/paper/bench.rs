@@ -99,11 +99,12 @@ pub struct BenchRecord {
     /// samplers and in files written before it was recorded).
     #[serde(default)]
     pub metric_adaptation: String,
-    /// laplace-is: the Pareto shape k̂ of its importance weights (null for the MCMC samplers
+    /// laplace-is, independence: the Pareto shape k̂ of their proposals' importance weights
+    /// (independence: its warm-up's; null for the other samplers
     /// and in files written before it was recorded).
     #[serde(default)]
     pub khat: Option<f64>,
-    /// laplace-is: k̂ > 0.7 and NUTS drew instead; the cost is the whole of both.
+    /// laplace-is, independence: k̂ > 0.7 and NUTS drew instead; the cost is the whole of both.
     #[serde(default)]
     pub fell_back: bool,
 }

@@ -3,9 +3,8 @@
 
 use std::time::Instant;
 
-use super::{
-    Error, Fittable, MetricAdaptation, PhaseCost, RunOutput, RunSettings, SamplerKind, finish_run,
-};
+use super::fallback::{falls_back, nuts_instead};
+use super::{Error, Fittable, PhaseCost, RunOutput, RunSettings, finish_run};
 use crate::density::DensityError;
 use crate::optimize::MapEstimate;
 use crate::sampler::importance::{NAME, importance_sample};
@@ -62,28 +61,9 @@ pub(super) fn laplace_is<P: Fittable>(
         ..finish_run(NAME, run.chains, map, started)
     };
     output.min_ess_bulk = output.min_ess_bulk.min(weights_ess);
-    if khat <= settings.fallback_above || !settings.fallback {
+    if !falls_back(khat, settings) {
         return Ok(output);
     }
-    // The Laplace covariance k̂ just rejected is no metric to trust either: NUTS re-estimates
-    // it in Stan's windows, with their warm-up.
-    let nuts = RunSettings {
-        sampler: SamplerKind::NutsDense,
-        chain: crate::sampler::ChainSettings {
-            warmup: super::default_warmup(SamplerKind::NutsDense, MetricAdaptation::Windows),
-            ..settings.chain.clone()
-        },
-        metric_adaptation: MetricAdaptation::Windows,
-        ..settings.clone()
-    };
-    let mut posterior = posterior.clone();
-    let fallback = super::run_sampler(&mut posterior, &nuts, &format!("{label} fallback"))?;
-    Ok(RunOutput {
-        khat: Some(khat),
-        fell_back: true,
-        map: output.map + fallback.map,
-        warmup: output.warmup + output.sampling + fallback.warmup,
-        wall_seconds: started.elapsed().as_secs_f64(),
-        ..fallback
-    })
+    let spent = output.warmup + output.sampling;
+    nuts_instead(posterior, settings, label, khat, output.map, spent, started)
 }

@@ -25,18 +25,18 @@ use crate::sampler::clock::Stopwatch;
 use crate::sampler::driver::chain_rng;
 use crate::sampler::fisher_mala::{FisherMala, FisherMalaAdaptation};
 use crate::sampler::hmc::{Hmc, HmcSettings};
-use crate::sampler::independence::{Independence, IndependenceTuning};
 use crate::sampler::mala::{Mala, MalaAdaptation};
 use crate::sampler::metric::{Metric, MetricKind};
 use crate::sampler::metropolis::{Metropolis, PyMc3Tuning};
 use crate::sampler::nuts::{Nuts, NutsSettings};
-use crate::sampler::proposal::LaplaceProposal;
 use crate::sampler::{Adaptation, ChainOutput, Kernel, RunControl, run_chains_until};
 
 use crate::error::{Error, InputError};
 
 pub mod cost;
+mod fallback;
 mod importance;
+mod independence;
 pub mod settings;
 pub use crate::sampler::PhaseCost;
 pub use cost::{RunCost, ratio_2sf};
@@ -73,9 +73,12 @@ pub struct RunOutput {
     pub divergences: usize,
     pub map_log_density: f64,
     pub log_evidence_laplace: f64,
-    /// laplace-is: the Pareto shape k̂ of its importance weights (`None` for the MCMC samplers).
+    /// laplace-is, independence: the Pareto shape k̂ of the importance weights of their
+    /// proposals (independence: of its warm-up's; `None` for a warm-up too short to judge and
+    /// for the other samplers).
     pub khat: Option<f64>,
-    /// laplace-is: k̂ said the Laplace approximation cannot be trusted and NUTS drew instead.
+    /// laplace-is, independence: k̂ said the Laplace approximation cannot be trusted and NUTS
+    /// drew instead.
     pub fell_back: bool,
 }
 
@@ -170,14 +173,20 @@ where
                 Ok((posterior.clone(), k, a))
             },
             bars.as_ref().map(|(_, b)| b.as_slice()),
-            RunControl {
-                stop: settings.stop.as_deref(),
-                save_warmup: settings.save_warmup,
-                transitions: settings.transitions.as_deref(),
-            },
+            run_control(settings),
         )
     };
     Ok(in_pool(settings.threads, work)??)
+}
+
+/// What the settings ask of the chains beside their length: the stop flag, the warm-up's
+/// draws, the transition count.
+fn run_control(settings: &RunSettings) -> RunControl<'_> {
+    RunControl {
+        stop: settings.stop.as_deref(),
+        save_warmup: settings.save_warmup,
+        transitions: settings.transitions.as_deref(),
+    }
 }
 
 /// `work` on a pool of `threads` (rayon's global pool when `None`).
@@ -265,8 +274,16 @@ pub fn run_sampler<P: Fittable>(
     )?;
     let map_cost = PhaseCost::counted(map_watch.elapsed(), &counted);
     let label = format!("{label} {}", settings.sampler.name());
-    if settings.sampler == SamplerKind::LaplaceIs {
-        return importance::laplace_is(posterior, &map, map_cost, settings, &label, started);
+    match settings.sampler {
+        SamplerKind::LaplaceIs => {
+            return importance::laplace_is(posterior, &map, map_cost, settings, &label, started);
+        }
+        SamplerKind::Independence => {
+            return independence::independence(
+                posterior, &map, map_cost, &inits, settings, &label, started,
+            );
+        }
+        _ => {}
     }
     let chains = dispatch(posterior, &map, &inits, settings, &label)?;
     Ok(RunOutput {
@@ -305,16 +322,8 @@ fn dispatch<P: Fittable>(
                 MalaAdaptation::step_size_only(),
             ))
         })?)),
-        SamplerKind::Independence => {
-            Ok(outputs(execute(posterior, inits, settings, label, |_| {
-                let proposal = LaplaceProposal::new(&map.x, &map.hessian).map_err(fatal)?;
-                let mut kernel = Independence::new(proposal);
-                IndependenceTuning::start(&mut kernel);
-                Ok((kernel, IndependenceTuning::default()))
-            })?))
-        }
-        SamplerKind::LaplaceIs => Err(Error::invalid(
-            "importance sampling runs no chains: run_sampler sends it to its own path",
+        SamplerKind::LaplaceIs | SamplerKind::Independence => Err(Error::invalid(
+            "the Laplace samplers judge their proposals by k̂: run_sampler sends them to their own paths",
         )),
         SamplerKind::FisherMala => Ok(outputs(execute(posterior, inits, settings, label, |_| {
             let step = 1.65 * (map.x.len() as f64).powf(-1.0 / 3.0);

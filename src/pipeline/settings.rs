@@ -31,7 +31,7 @@ pub enum SamplerKind {
     /// Simplified manifold MALA with the Gauss–Newton (Fisher) metric.
     FisherMala,
     /// Independence Metropolis–Hastings from a Student-t at the MAP with the Laplace
-    /// covariance; no gradients.
+    /// covariance; no gradients. Falls back to NUTS when k̂ of its warm-up's proposals > 0.7.
     Independence,
     /// Importance sampling from the same Student-t, Pareto-smoothed, resampled to equal
     /// weights; falls back to NUTS when k̂ > 0.7.
@@ -195,10 +195,10 @@ pub struct RunSettings {
     /// Counts every chain's transitions for a caller's progress display; changes no draw.
     #[serde(skip)]
     pub transitions: Option<Arc<AtomicUsize>>,
-    /// laplace-is: run NUTS (dense) on the same problem instead when k̂ says the Laplace
-    /// approximation cannot be trusted.
+    /// laplace-is, independence: run NUTS (dense) on the same problem instead when k̂ says the
+    /// Laplace approximation cannot be trusted.
     pub fallback: bool,
-    /// laplace-is: the k̂ above which it falls back (0.7, where PSIS stops being reliable, by
+    /// laplace-is, independence: the k̂ above which they fall back (0.7, where PSIS stops being reliable, by
     /// default; a diagnosis's fits ask for 0.5, below which its estimates converge at the
     /// Monte Carlo rate).
     pub fallback_above: f64,

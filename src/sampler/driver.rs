@@ -1,6 +1,7 @@
 //! The driver: warm-up then sampling for any kernel and adaptation, one chain or several in
 //! parallel, with per-chain random streams so that draws do not depend on the thread count.
 
+use std::borrow::BorrowMut;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
@@ -168,6 +169,7 @@ pub struct RunControl<'a> {
 }
 
 /// One chain's place in a run.
+#[derive(Clone, Copy)]
 struct ChainRun<'a> {
     init: &'a [f64],
     settings: &'a ChainSettings,
@@ -176,11 +178,11 @@ struct ChainRun<'a> {
     control: RunControl<'a>,
 }
 
-/// [`run_chain`] under a [`RunControl`].
+/// [`run_chain`] under a [`RunControl`]: its warm-up, then its sampling, on the same thread.
 fn run_chain_until<P, K, A>(
     density: P,
-    mut kernel: K,
-    mut adaptation: A,
+    kernel: K,
+    adaptation: A,
     rng: &mut ChaCha8Rng,
     run: ChainRun<'_>,
 ) -> Result<(ChainOutput, K), DensityError>
@@ -189,23 +191,61 @@ where
     K: Kernel<Counted<P>>,
     A: Adaptation<K>,
 {
+    warm_up(density, kernel, adaptation, rng, run)?.sample()
+}
+
+/// Ends a run whose stop flag is set.
+fn check(control: &RunControl<'_>) -> Result<(), DensityError> {
+    match control.stop {
+        Some(flag) if flag.load(Ordering::Relaxed) => Err(DensityError::fatal(STOPPED)),
+        _ => Ok(()),
+    }
+}
+
+/// A chain at the end of its warm-up, its kernel adapted and frozen, before its first draw:
+/// what [`warm_up_chains`] hands back so that a caller can judge the warm-up of every chain
+/// before any of them spends its draws. `R` is its random stream, owned or borrowed.
+pub struct WarmChain<'a, P, K, R = ChaCha8Rng> {
+    density: Counted<P>,
+    kernel: K,
+    state: State,
+    rng: R,
+    run: ChainRun<'a>,
+    reporter: Reporter<'a>,
+    names: Vec<String>,
+    warmup: PhaseCost,
+    warmup_draws: Vec<Vec<f64>>,
+    warmup_records: Vec<DrawRecord>,
+}
+
+/// A chain's warm-up: the initial state, `settings.warmup` transitions with adaptation, then
+/// the adaptation's final values.
+fn warm_up<'a, P, K, A, R>(
+    density: P,
+    mut kernel: K,
+    mut adaptation: A,
+    mut rng: R,
+    run: ChainRun<'a>,
+) -> Result<WarmChain<'a, P, K, R>, DensityError>
+where
+    P: LogDensity,
+    K: Kernel<Counted<P>>,
+    A: Adaptation<K>,
+    R: BorrowMut<ChaCha8Rng>,
+{
     let ChainRun {
-        init,
         settings,
         chain,
         progress,
         control,
+        ..
     } = run;
-    let check = || match control.stop {
-        Some(flag) if flag.load(Ordering::Relaxed) => Err(DensityError::fatal(STOPPED)),
-        _ => Ok(()),
-    };
     settings.validate().map_err(DensityError::fatal)?;
     // The warm-up's time includes the initial point's evaluation, as its counts do.
     let warmup_watch = Stopwatch::start();
     let mut density = Counted::new(density);
     let names = density.output_names();
-    let mut state: State = kernel.init_state(&mut density, init)?;
+    let mut state: State = kernel.init_state(&mut density, run.init)?;
     if !state.log_density.is_finite() {
         return Err(DensityError::fatal(format!(
             "chain {chain}: the initial point has zero density"
@@ -218,8 +258,8 @@ where
     let mut constrained = Vec::new();
     let (mut warmup_draws, mut warmup_records) = (Vec::new(), Vec::new());
     for iteration in 0..settings.warmup {
-        check()?;
-        let info = kernel.step(&mut density, &mut state, rng)?;
+        check(&control)?;
+        let info = kernel.step(&mut density, &mut state, rng.borrow_mut())?;
         divergences_warmup += info.divergent as usize;
         if control.save_warmup {
             density.constrain(&state.x, &mut constrained);
@@ -234,51 +274,103 @@ where
     }
     adaptation.finish(&mut kernel);
     let warmup = PhaseCost::counted(warmup_watch.elapsed(), &density);
-
-    let first_kept = settings.draws - settings.kept();
-    let mut draws = Vec::with_capacity(settings.kept());
-    let mut unconstrained = Vec::with_capacity(settings.kept());
-    let mut records = Vec::with_capacity(settings.kept());
-    let mut divergences = 0usize;
-    let mut accept_sum = 0.0;
-    let mut last_step_size = f64::NAN;
-    let sampling_watch = Stopwatch::start();
-    for i in 0..settings.draws {
-        check()?;
-        let info = kernel.step(&mut density, &mut state, rng)?;
-        divergences += info.divergent as usize;
-        accept_sum += info.accept_stat;
-        last_step_size = info.step_size;
-        if i >= first_kept {
-            density.constrain(&state.x, &mut constrained);
-            draws.push(constrained.clone());
-            unconstrained.push(state.x.clone());
-            records.push(DrawRecord::of(&state, &info));
-        }
-        reporter.tick(settings.warmup + i, &info, divergences, "sampling");
-        if let Some(count) = control.transitions {
-            count.fetch_add(1, Ordering::Relaxed);
-        }
-    }
-    let sampling = PhaseCost::counted(sampling_watch.elapsed(), &density).after(&warmup);
-    reporter.finish(divergences);
-    let output = ChainOutput {
-        chain,
-        sampler: kernel.name(),
+    Ok(WarmChain {
+        density,
+        kernel,
+        state,
+        rng,
+        run,
+        reporter,
         names,
-        draws,
-        unconstrained,
-        records,
         warmup,
-        sampling,
-        uses_gradient: kernel.uses_gradient(),
-        divergences,
-        mean_accept_stat: accept_sum / settings.draws as f64,
-        final_step_size: last_step_size,
         warmup_draws,
         warmup_records,
-    };
-    Ok((output, kernel))
+    })
+}
+
+impl<P, K, R> WarmChain<'_, P, K, R>
+where
+    P: LogDensity,
+    K: Kernel<Counted<P>>,
+    R: BorrowMut<ChaCha8Rng>,
+{
+    /// The kernel as warm-up left it.
+    pub fn kernel(&self) -> &K {
+        &self.kernel
+    }
+
+    /// What the warm-up cost, the initial point's evaluation included.
+    pub fn warmup(&self) -> PhaseCost {
+        self.warmup
+    }
+
+    /// The sampling: `settings.draws` transitions with the kernel frozen, the last
+    /// `settings.kept()` of them kept.
+    pub fn sample(self) -> Result<(ChainOutput, K), DensityError> {
+        let WarmChain {
+            mut density,
+            mut kernel,
+            mut state,
+            mut rng,
+            run,
+            reporter,
+            names,
+            warmup,
+            warmup_draws,
+            warmup_records,
+        } = self;
+        let ChainRun {
+            settings,
+            chain,
+            control,
+            ..
+        } = run;
+        let first_kept = settings.draws - settings.kept();
+        let mut draws = Vec::with_capacity(settings.kept());
+        let mut unconstrained = Vec::with_capacity(settings.kept());
+        let mut records = Vec::with_capacity(settings.kept());
+        let mut constrained = Vec::new();
+        let mut divergences = 0usize;
+        let mut accept_sum = 0.0;
+        let mut last_step_size = f64::NAN;
+        let sampling_watch = Stopwatch::start();
+        for i in 0..settings.draws {
+            check(&control)?;
+            let info = kernel.step(&mut density, &mut state, rng.borrow_mut())?;
+            divergences += info.divergent as usize;
+            accept_sum += info.accept_stat;
+            last_step_size = info.step_size;
+            if i >= first_kept {
+                density.constrain(&state.x, &mut constrained);
+                draws.push(constrained.clone());
+                unconstrained.push(state.x.clone());
+                records.push(DrawRecord::of(&state, &info));
+            }
+            reporter.tick(settings.warmup + i, &info, divergences, "sampling");
+            if let Some(count) = control.transitions {
+                count.fetch_add(1, Ordering::Relaxed);
+            }
+        }
+        let sampling = PhaseCost::counted(sampling_watch.elapsed(), &density).after(&warmup);
+        reporter.finish(divergences);
+        let output = ChainOutput {
+            chain,
+            sampler: kernel.name(),
+            names,
+            draws,
+            unconstrained,
+            records,
+            warmup,
+            sampling,
+            uses_gradient: kernel.uses_gradient(),
+            divergences,
+            mean_accept_stat: accept_sum / settings.draws as f64,
+            final_step_size: last_step_size,
+            warmup_draws,
+            warmup_records,
+        };
+        Ok((output, kernel))
+    }
 }
 
 /// The random stream of chain `chain` under master seed `seed`: independent of which thread
@@ -343,6 +435,58 @@ where
         .collect()
 }
 
+/// The first half of [`run_chains_until`]: every chain's warm-up in parallel, each on its own
+/// stream, stopped at the end of warm-up. [`sample_chains`] then draws exactly what
+/// [`run_chains_until`] would have: the split moves no draw, it lets a caller look at every
+/// adapted kernel first and spend no draws on a run it would not trust.
+pub fn warm_up_chains<'a, P, K, A, F>(
+    inits: &'a [Vec<f64>],
+    settings: &'a ChainSettings,
+    seed: u64,
+    make: F,
+    progress: Option<&'a [ProgressBar]>,
+    control: RunControl<'a>,
+) -> Result<Vec<WarmChain<'a, P, K>>, DensityError>
+where
+    P: LogDensity + Send,
+    K: Kernel<Counted<P>> + Send,
+    A: Adaptation<K>,
+    F: Fn(usize) -> Result<(P, K, A), DensityError> + Sync,
+{
+    inits
+        .par_iter()
+        .enumerate()
+        .map(|(chain, init)| {
+            let (density, kernel, adaptation) = make(chain)?;
+            let chain_run = ChainRun {
+                init,
+                settings,
+                chain,
+                progress: progress.and_then(|bars| bars.get(chain)),
+                control,
+            };
+            warm_up(
+                density,
+                kernel,
+                adaptation,
+                chain_rng(seed, chain),
+                chain_run,
+            )
+        })
+        .collect()
+}
+
+/// The second half of [`run_chains_until`]: every warmed-up chain's sampling, in parallel.
+pub fn sample_chains<P, K>(
+    chains: Vec<WarmChain<'_, P, K>>,
+) -> Result<Vec<(ChainOutput, K)>, DensityError>
+where
+    P: LogDensity + Send,
+    K: Kernel<Counted<P>> + Send,
+{
+    chains.into_par_iter().map(WarmChain::sample).collect()
+}
+
 /// Updates a progress bar at most ~10 times a second, with the chain's health in the message.
 struct Reporter<'a> {
     bar: Option<&'a ProgressBar>,
@@ -389,6 +533,43 @@ impl<'a> Reporter<'a> {
                 "done  accept {:.2}  divergences {divergences}",
                 acc as f64 / 1000.0 / n.max(1) as f64
             ));
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampler::mala::{Mala, MalaAdaptation};
+    use crate::sampler::metric::{Metric, MetricKind};
+    use crate::sampler::targets::Gaussian;
+
+    #[test]
+    fn a_run_split_at_the_end_of_warm_up_draws_what_a_run_in_one_piece_does() {
+        let target = Gaussian::correlated(3, 0.5, 10.0);
+        let inits = vec![vec![0.1; 3], vec![-0.2; 3], vec![0.3; 3]];
+        let settings = ChainSettings {
+            warmup: 50,
+            draws: 40,
+            keep: Some(30),
+        };
+        let make = |_| {
+            let kernel = Mala::new(Metric::identity(3, MetricKind::Diagonal), 0.5).unwrap();
+            Ok((target.clone(), kernel, MalaAdaptation::step_size_only()))
+        };
+        let whole = run_chains(&inits, &settings, 8, make, None).unwrap();
+        let control = RunControl::default();
+        let warm = warm_up_chains(&inits, &settings, 8, make, None, control).unwrap();
+        let counts = |c: PhaseCost| (c.density_evaluations, c.gradient_evaluations);
+        assert_eq!(counts(warm[1].warmup()), counts(whole[1].0.warmup));
+        let split = sample_chains(warm).unwrap();
+        for ((a, _), (b, _)) in whole.iter().zip(&split) {
+            assert_eq!(a.draws, b.draws);
+            assert_eq!(a.records, b.records);
+            assert_eq!(
+                a.sampling.density_evaluations,
+                b.sampling.density_evaluations
+            );
         }
     }
 }

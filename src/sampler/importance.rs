@@ -224,17 +224,30 @@ fn add_component(components: &mut Vec<(LaplaceProposal, usize)>, q: &LaplaceProp
 /// log π(x) − log Σᵣ (nᵣ/N) qᵣ(x) for every proposal so far: each weighed against the mixture of
 /// all rounds' proposals (with one round, exactly log π − log q).
 fn log_weights(rounds: &[Vec<Block>], components: &[(LaplaceProposal, usize)]) -> Vec<f64> {
+    let points = rounds.iter().flatten().flat_map(|b| {
+        b.x.iter()
+            .map(Vec::as_slice)
+            .zip(b.log_density.iter().copied())
+    });
+    mixture_log_weights(points, components)
+}
+
+/// The importance log weights log π(x) − log Σᵣ (nᵣ/N) qᵣ(x) of proposals `(x, log π(x))` drawn
+/// nᵣ from each of the `components` (qᵣ, nᵣ): every draw weighed against the mixture of all of
+/// them (the balance heuristic; with one component, exactly log π − log q). Importance sampling
+/// weighs its rounds' draws so, and the independence sampler its warm-up's, drawn from each of
+/// the proposal shapes it tries.
+pub fn mixture_log_weights<'a>(
+    points: impl Iterator<Item = (&'a [f64], f64)>,
+    components: &[(LaplaceProposal, usize)],
+) -> Vec<f64> {
     let total: usize = components.iter().map(|c| c.1).sum();
     let log_shares: Vec<f64> = components
         .iter()
         .map(|(_, n)| (*n as f64).ln() - (total as f64).ln())
         .collect();
-    let points = rounds
-        .iter()
-        .flatten()
-        .flat_map(|b| b.x.iter().zip(&b.log_density));
     points
-        .map(|(x, &lp)| {
+        .map(|(x, lp)| {
             if lp == f64::NEG_INFINITY {
                 // Outside the support, or its solve failed: it weighs nothing.
                 return lp;

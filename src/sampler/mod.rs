@@ -26,8 +26,8 @@ pub mod welford;
 
 pub use cost::PhaseCost;
 pub use driver::{
-    ChainOutput, ChainSettings, DrawRecord, RunControl, STOPPED, run_chain, run_chains,
-    run_chains_until,
+    ChainOutput, ChainSettings, DrawRecord, RunControl, STOPPED, WarmChain, run_chain, run_chains,
+    run_chains_until, sample_chains, warm_up_chains,
 };
 
 use rand_chacha::ChaCha8Rng;

@@ -1,0 +1,48 @@
+//! NUTS in place of a sampler that draws from the Laplace approximation, when the Pareto k̂ of
+//! its importance weights says the approximation cannot be trusted: laplace-is's and the
+//! independence sampler's one way out, so that both fall back alike and record it alike.
+
+use std::time::Instant;
+
+use super::{Error, Fittable, MetricAdaptation, PhaseCost, RunOutput, RunSettings, SamplerKind};
+
+/// Whether a run whose proposals gave `khat` falls back: k̂ above `settings.fallback_above`, or
+/// none could be fitted (NaN), unless `settings.fallback` is off.
+pub(super) fn falls_back(khat: f64, settings: &RunSettings) -> bool {
+    settings.fallback && !(khat <= settings.fallback_above)
+}
+
+/// NUTS with a dense metric tuned in Stan's windows on `posterior`, from the settings' chains,
+/// draws and seed. Its record keeps `khat`, says `fell_back`, adds `map` (the Laplace sampler's
+/// MAP) to its own, and counts `spent` (all the Laplace sampler drew) in its warm-up.
+pub(super) fn nuts_instead<P: Fittable>(
+    posterior: &P,
+    settings: &RunSettings,
+    label: &str,
+    khat: f64,
+    map: PhaseCost,
+    spent: PhaseCost,
+    started: Instant,
+) -> Result<RunOutput, Error> {
+    // The Laplace covariance k̂ just rejected is no metric to trust either: NUTS re-estimates
+    // it in Stan's windows, with their warm-up.
+    let nuts = RunSettings {
+        sampler: SamplerKind::NutsDense,
+        chain: crate::sampler::ChainSettings {
+            warmup: super::default_warmup(SamplerKind::NutsDense, MetricAdaptation::Windows),
+            ..settings.chain.clone()
+        },
+        metric_adaptation: MetricAdaptation::Windows,
+        ..settings.clone()
+    };
+    let mut posterior = posterior.clone();
+    let fallback = super::run_sampler(&mut posterior, &nuts, &format!("{label} fallback"))?;
+    Ok(RunOutput {
+        khat: Some(khat),
+        fell_back: true,
+        map: map + fallback.map,
+        warmup: spent + fallback.warmup,
+        wall_seconds: started.elapsed().as_secs_f64(),
+        ..fallback
+    })
+}
