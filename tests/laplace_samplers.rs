@@ -163,25 +163,36 @@ fn a_friction_term_at_its_bound_is_flagged_by_khat_and_falls_back_to_nuts() {
 /// The friction target for the independence sampler: its warm-up's proposals come from a
 /// mixture of eight t shapes down to ν = 5 at 1.2 times the Laplace scale, whose heavy tails
 /// cover the exponential left tail of log T_c better than laplace-is's single ν = 30, so k̂ sits
-/// nearer the line. When written (4 × 320 proposals, chain seed 99) it was 0.660, 0.899, 0.687,
-/// 0.643 on noise seeds 1–4 (0.679, 0.802, 0.672, 0.762 for a `viscous_friction` term): flagged
-/// on seed 2 only, while the kept chains' R-hat was 1.03–1.04 on all four. So this claims the
-/// fallback on seed 2, where k̂ is clear of 0.7; on the others the check lets through chains
-/// that R-hat then has to catch.
+/// lower. When written (4 × 320 proposals, chain seed 99) it was 0.660, 0.899, 0.687, 0.643 on
+/// noise seeds 1–4, and the chains kept at the 0.7 that laplace-is uses had R-hat 1.03–1.04 on
+/// all four: a chain sticks where the weights' variance is infinite, k > ½, which is the
+/// independence sampler's bound (`pipeline::independence`). Flagged and handed to NUTS on all
+/// four.
 #[test]
-fn independence_on_a_friction_term_at_its_bound_is_flagged_on_noise_seed_2_and_falls_back() {
-    let mut post = friction_at_zero("coulomb_friction", 2);
-    let run = run_sampler(&mut post, &independence(true, 1000), "friction").unwrap();
-    let khat = run.khat.unwrap();
-    eprintln!(
-        "independence k̂ {khat:.3}; fell back: {}, R-hat {:.4}, min bulk ESS {:.0}, {} divergences",
-        run.fell_back, run.max_rhat, run.min_ess_bulk, run.divergences
-    );
-    assert!(khat > 0.8, "k̂ = {khat}");
-    assert!(run.fell_back);
-    assert_eq!(run.sampler, "nuts-dense");
-    assert!(run.max_rhat <= 1.01, "R-hat {}", run.max_rhat);
-    assert!(run.min_ess_bulk >= 400.0, "bulk ESS {}", run.min_ess_bulk);
+fn independence_on_a_friction_term_at_its_bound_is_flagged_and_falls_back() {
+    for noise_seed in 1..=4 {
+        let mut post = friction_at_zero("coulomb_friction", noise_seed);
+        let run = run_sampler(&mut post, &independence(true, 1000), "friction").unwrap();
+        let khat = run.khat.unwrap();
+        eprintln!(
+            "seed {noise_seed}: independence k̂ {khat:.3}; fell back: {}, R-hat {:.4}, min bulk \
+             ESS {:.0}, {} divergences",
+            run.fell_back, run.max_rhat, run.min_ess_bulk, run.divergences
+        );
+        assert!(khat > 0.5, "seed {noise_seed}: k̂ = {khat}");
+        assert!(run.fell_back, "seed {noise_seed}");
+        assert_eq!(run.sampler, "nuts-dense");
+        assert!(
+            run.max_rhat <= 1.01,
+            "seed {noise_seed}: R-hat {}",
+            run.max_rhat
+        );
+        assert!(
+            run.min_ess_bulk >= 400.0,
+            "seed {noise_seed}: bulk ESS {}",
+            run.min_ess_bulk
+        );
+    }
 }
 
 /// Where the posterior is close to its Laplace approximation the warm-up's weights are light-

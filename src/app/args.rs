@@ -128,7 +128,7 @@ impl ValueEnum for SamplerKind {
                 "Simplified manifold MALA with the Gauss–Newton (Fisher) metric"
             }
             SamplerKind::Independence => {
-                "Independence Metropolis–Hastings from a Student-t at the MAP with the Laplace covariance; NUTS when k̂ of its warm-up > 0.7"
+                "Independence Metropolis–Hastings from a Student-t at the MAP with the Laplace covariance; NUTS when k̂ of its warm-up > 0.5"
             }
             SamplerKind::LaplaceIs => {
                 "Importance sampling from that Student-t, Pareto-smoothed; NUTS when k̂ > 0.7"
