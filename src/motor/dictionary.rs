@@ -49,6 +49,14 @@ pub const PERIODIC: [usize; 2] = [15, 16];
 /// the charge alone.
 pub const U_CHARGE: usize = 17;
 
+/// Whether the state fingerprint offers function `f` in balance `b` (0 torque, 1 voltage): the
+/// supply scaled by its charge acts where the supply does, in the voltage balance; in the
+/// torque balance it would be a column with no physics behind it, one more for chance to pick.
+/// A law written by hand may still hold it in either.
+pub fn offered_in(f: usize, b: usize) -> bool {
+    f != U_CHARGE || b == 1
+}
+
 /// The state a function needs integrated (0: charge, 1: heat, 2: θ), if any.
 pub fn state_of(function: usize) -> Option<usize> {
     match function {

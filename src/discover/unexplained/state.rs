@@ -15,8 +15,9 @@
 //! ranking pays it; ln(columns tried) pays for having picked the best of that many (under the
 //! model each gain is ½χ²₁, and the largest of m exceeds a level about m times as often as one
 //! does, i.e. costs ln m nats); the threshold is the ranking's margin, for the ranking's
-//! reason. With N = 1002 and the 21 columns of a balance the first column needs a gain of
-//! 3.45 + 3.04 + 2 = 8.49 nats: 21·P(χ²₁ > 17.0) ≈ 0.1% per balance on a null record. The
+//! reason. With N = 1002 and the 21 columns of the voltage balance (20 of the torque balance)
+//! the first column needs a gain of 3.45 + 3.04 + 2 = 8.49 nats: 21·P(χ²₁ > 17.0) ≈ 0.1% per
+//! balance on a null record. The
 //! fingerprint's score is
 //! the gain less the first two prices of each column taken (as the other alternatives' scores
 //! are their gain less ½·ln N per degree and the logarithm of their grid); the verdict's
@@ -202,6 +203,7 @@ fn select(
         let open: Vec<usize> = (0..columns.len())
             .filter(|j| !chosen.contains(j))
             .filter(|&j| !(stribeck_taken && columns[j].omega_s.is_some()))
+            .filter(|&j| dictionary::offered_in(columns[j].function, balance))
             .collect();
         if open.is_empty() {
             break;
