@@ -4,6 +4,8 @@
 
 use std::time::Instant;
 
+use crate::diagnostics::KHAT_UNRELIABLE;
+
 use super::{Error, Fittable, MetricAdaptation, PhaseCost, RunOutput, RunSettings, SamplerKind};
 
 /// Whether a run whose proposals gave `khat` falls back: k̂ above `settings.fallback_above`, or
@@ -12,7 +14,7 @@ pub(super) fn falls_back(khat: f64, settings: &RunSettings) -> bool {
     settings.fallback && !(khat <= settings.fallback_above)
 }
 
-/// NUTS with a dense metric tuned in Stan's windows on `posterior`, from the settings' chains,
+/// NUTS with a dense metric on `posterior` (tuned in Stan's windows where k̂ > 0.7, the Laplace one below), from the settings' chains,
 /// draws and seed. Its record keeps `khat`, says `fell_back`, adds `map` (the Laplace sampler's
 /// MAP) to its own, and counts `spent` (all the Laplace sampler drew) in its warm-up.
 pub(super) fn nuts_instead<P: Fittable>(
@@ -24,15 +26,24 @@ pub(super) fn nuts_instead<P: Fittable>(
     spent: PhaseCost,
     started: Instant,
 ) -> Result<RunOutput, Error> {
-    // The Laplace covariance k̂ just rejected is no metric to trust either: NUTS re-estimates
-    // it in Stan's windows, with their warm-up.
+    // Where k̂ > 0.7 (or none could be fitted) the Laplace covariance is no metric to trust
+    // either: NUTS re-estimates it in Stan's windows, with their warm-up. Between a stricter
+    // line and 0.7 (diagnose's fits fall back above 0.5, the independence chain too) the
+    // approximation was refused for weighing draws, whose error converges slowly there, not as
+    // a shape: NUTS keeps it as its metric, tunes only the step size, and its own R-hat and ESS
+    // judge the result.
+    let metric_adaptation = if khat <= KHAT_UNRELIABLE {
+        MetricAdaptation::Laplace
+    } else {
+        MetricAdaptation::Windows
+    };
     let nuts = RunSettings {
         sampler: SamplerKind::NutsDense,
         chain: crate::sampler::ChainSettings {
-            warmup: super::default_warmup(SamplerKind::NutsDense, MetricAdaptation::Windows),
+            warmup: super::default_warmup(SamplerKind::NutsDense, metric_adaptation),
             ..settings.chain.clone()
         },
-        metric_adaptation: MetricAdaptation::Windows,
+        metric_adaptation,
         ..settings.clone()
     };
     let mut posterior = posterior.clone();

@@ -19,7 +19,7 @@ pub const IS_SHAPE: (f64, f64) = (30.0, 1.0);
 /// Importance sampling of `posterior` from the Student-t at `map`: `chains × draws` proposals,
 /// resampled. Its `min_ess_bulk` is the smaller of the smoothed weights' ESS and the resampled
 /// draws' bulk ESS. When k̂ > `settings.fallback_above` (0.7 by default; or cannot be fitted) and `settings.fallback`, NUTS with a
-/// dense metric tuned in Stan's windows runs instead; its record keeps k̂, says `fell_back`, and counts the
+/// dense metric runs instead (`fallback::nuts_instead`); its record keeps k̂, says `fell_back`, and counts the
 /// importance sampling it replaced in its warm-up.
 pub(super) fn laplace_is<P: Fittable>(
     posterior: &P,
