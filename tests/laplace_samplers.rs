@@ -207,15 +207,9 @@ fn independence_on_a_friction_term_at_its_bound_is_flagged_and_falls_back() {
     }
 }
 
-/// Where the posterior is close to its Laplace approximation the warm-up's weights are light-
-/// tailed and independence keeps its draws: an exact Gaussian (the banana unbent; k̂ −1.61
-/// when written) and BM2(K = 3) on the paper's motor with the cases' noise (k̂ −0.33).
-#[test]
-fn independence_on_a_posterior_close_to_gaussian_keeps_its_own_draws() {
-    let mut gaussian = Banana {
-        bend: 0.0,
-        width: 0.2,
-    };
+/// BM2(K = 3) on the paper's motor (constant 24 V) with the cases' noise, noise seed 2: a
+/// posterior with discrepancy coefficients, close to its Laplace approximation.
+fn paper_motor_bm2_k3() -> CalibrationPosterior {
     let times = sample_times(DURATION, SAMPLES);
     let motor = MotorModel::new(MotorParameters::default(), VoltageInput::Constant);
     let data = generate(&motor, &times, &NOISE_SD, 2).unwrap();
@@ -225,7 +219,19 @@ fn independence_on_a_posterior_close_to_gaussian_keeps_its_own_draws() {
         model: ModelFile::default(),
         reference: None,
     };
-    let mut bm2 = problem.posterior(&ModelSettings::bm2(3)).unwrap();
+    problem.posterior(&ModelSettings::bm2(3)).unwrap()
+}
+
+/// Where the posterior is close to its Laplace approximation the warm-up's weights are light-
+/// tailed and independence keeps its draws: an exact Gaussian (the banana unbent; k̂ −1.61
+/// when written) and BM2(K = 3) on the paper's motor with the cases' noise (k̂ −0.33).
+#[test]
+fn independence_on_a_posterior_close_to_gaussian_keeps_its_own_draws() {
+    let mut gaussian = Banana {
+        bend: 0.0,
+        width: 0.2,
+    };
+    let mut bm2 = paper_motor_bm2_k3();
     let runs = [
         run_sampler(&mut gaussian, &independence(true, 1000), "gaussian").unwrap(),
         run_sampler(&mut bm2, &independence(true, 1000), "bm2").unwrap(),
@@ -261,15 +267,6 @@ fn the_recentring_runs_where_there_are_discrepancy_coefficients_only() {
     let mut bm1 = friction_at_zero("viscous_friction", 2);
     assert_eq!(run(&mut bm1, 100), run(&mut bm1, 0));
 
-    let times = sample_times(DURATION, SAMPLES);
-    let motor = MotorModel::new(MotorParameters::default(), VoltageInput::Constant);
-    let data = generate(&motor, &times, &NOISE_SD, 2).unwrap();
-    let problem = Problem {
-        label: "bm2".into(),
-        recordings: vec![recording_from(&data, "bm2", None)],
-        model: ModelFile::default(),
-        reference: None,
-    };
-    let mut bm2 = problem.posterior(&ModelSettings::bm2(3)).unwrap();
+    let mut bm2 = paper_motor_bm2_k3();
     assert_ne!(run(&mut bm2, 100), run(&mut bm2, 0));
 }
