@@ -96,8 +96,9 @@ pub struct RunArgs {
     /// HMC/NUTS: start from a saved adaptation and skip adapting (use with a short --warmup).
     #[arg(long)]
     pub load_adaptation: Option<PathBuf>,
-    /// laplace-is, independence: keep the Laplace sampler even when k̂ > 0.7 says the Laplace
-    /// approximation cannot be trusted (default: fall back to NUTS).
+    /// laplace-is, independence: keep the Laplace sampler even when k̂ says the Laplace
+    /// approximation cannot be trusted (above 0.7 for laplace-is, 0.5 for independence;
+    /// default: fall back to NUTS).
     #[arg(long)]
     pub no_fallback: bool,
 }
@@ -183,7 +184,7 @@ pub struct FitReport {
     /// laplace-is, independence: the Pareto shape k̂ of the importance weights of their
     /// proposals (independence: its warm-up's; null for the other samplers).
     pub khat: Option<f64>,
-    /// laplace-is, independence: k̂ > 0.7 and NUTS drew instead.
+    /// laplace-is, independence: k̂ above the sampler's line (0.7, 0.5) and NUTS drew instead.
     pub fell_back: bool,
     pub wall_seconds: Option<f64>,
     pub outputs: Vec<String>,

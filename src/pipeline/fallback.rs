@@ -8,10 +8,11 @@ use crate::diagnostics::KHAT_UNRELIABLE;
 
 use super::{Error, Fittable, MetricAdaptation, PhaseCost, RunOutput, RunSettings, SamplerKind};
 
-/// Whether a run whose proposals gave `khat` falls back: k̂ above `settings.fallback_above`, or
-/// none could be fitted (NaN), unless `settings.fallback` is off.
-pub(super) fn falls_back(khat: f64, settings: &RunSettings) -> bool {
-    settings.fallback && !(khat <= settings.fallback_above)
+/// Whether a run whose proposals gave `khat` falls back: k̂ above `settings.fallback_above` or
+/// above the sampler's own `ceiling` (the lower of the two), or none could be fitted (NaN),
+/// unless `settings.fallback` is off.
+pub(super) fn falls_back(khat: f64, settings: &RunSettings, ceiling: f64) -> bool {
+    settings.fallback && !(khat <= settings.fallback_above.min(ceiling))
 }
 
 /// NUTS with a dense metric on `posterior` (tuned in Stan's windows where k̂ > 0.7, the Laplace one below), from the settings' chains,

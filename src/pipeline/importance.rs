@@ -61,7 +61,7 @@ pub(super) fn laplace_is<P: Fittable>(
         ..finish_run(NAME, run.chains, map, started)
     };
     output.min_ess_bulk = output.min_ess_bulk.min(weights_ess);
-    if !falls_back(khat, settings) {
+    if !falls_back(khat, settings, f64::INFINITY) {
         return Ok(output);
     }
     let spent = output.warmup + output.sampling;

@@ -46,7 +46,8 @@ enum Judged {
 }
 
 /// The independence sampler on `posterior` from `inits`: every chain's warm-up, then k̂ of all
-/// their proposals' weights; when k̂ > `settings.fallback_above` or ½ ([`KHAT_CHAIN`]; or cannot be fitted) and
+/// their proposals' weights; when k̂ > the lower of `settings.fallback_above` and ½
+/// ([`KHAT_CHAIN`]; or cannot be fitted) and
 /// `settings.fallback`, no chain draws and NUTS runs instead, as for laplace-is
 /// ([`nuts_instead`]); otherwise the chains draw and the record keeps k̂.
 pub(super) fn independence<P: Fittable>(
@@ -77,11 +78,7 @@ pub(super) fn independence<P: Fittable>(
             control,
         )?;
         let khat = warmup_khat(warm.iter().map(|w| w.kernel()));
-        let bound = RunSettings {
-            fallback_above: settings.fallback_above.min(KHAT_CHAIN),
-            ..settings.clone()
-        };
-        if let Some(khat) = khat.filter(|&k| falls_back(k, &bound)) {
+        if let Some(khat) = khat.filter(|&k| falls_back(k, settings, KHAT_CHAIN)) {
             let warmup = warm.iter().map(|w| w.warmup()).sum();
             return Ok(Judged::Untrusted { khat, warmup });
         }

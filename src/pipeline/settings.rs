@@ -31,7 +31,7 @@ pub enum SamplerKind {
     /// Simplified manifold MALA with the Gauss–Newton (Fisher) metric.
     FisherMala,
     /// Independence Metropolis–Hastings from a Student-t at the MAP with the Laplace
-    /// covariance; no gradients. Falls back to NUTS when k̂ of its warm-up's proposals > 0.7.
+    /// covariance; no gradients. Falls back to NUTS when k̂ of its warm-up's proposals > 0.5.
     Independence,
     /// Importance sampling from the same Student-t, Pareto-smoothed, resampled to equal
     /// weights; falls back to NUTS when k̂ > 0.7.
@@ -198,9 +198,10 @@ pub struct RunSettings {
     /// laplace-is, independence: run NUTS (dense) on the same problem instead when k̂ says the
     /// Laplace approximation cannot be trusted.
     pub fallback: bool,
-    /// laplace-is, independence: the k̂ above which they fall back (0.7, where PSIS stops being reliable, by
-    /// default; a diagnosis's fits ask for 0.5, below which its estimates converge at the
-    /// Monte Carlo rate).
+    /// laplace-is, independence: the k̂ above which they fall back (0.7, where PSIS stops being
+    /// reliable, by default; a diagnosis's fits ask for 0.5, below which its estimates converge
+    /// at the Monte Carlo rate; the independence chain never goes above 0.5, where its mean
+    /// stay at a point becomes infinite).
     pub fallback_above: f64,
 }
 
