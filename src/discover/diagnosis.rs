@@ -26,7 +26,7 @@ use super::settings::{
 };
 use super::state::{StateFingerprint, fingerprint, reading};
 use super::ties::separating_input;
-use super::unexplained::{Unexplained, law_proposals, unexplained};
+use super::unexplained::{AsGivenLaws, Unexplained, unexplained};
 
 #[derive(Clone, Debug, Serialize)]
 pub struct RankEntry {
@@ -198,7 +198,8 @@ pub fn assemble(
     // The verdict after the library's selection; where its fingerprint names a dynamic term
     // that then fits better, the term joins (or replaces) the selection and the verdict is
     // asked again after it.
-    let mut left = unexplained(problem, &selected_fit, &none)?;
+    let as_given = AsGivenLaws::of(problem, &none)?;
+    let mut left = unexplained(problem, &selected_fit, &none, &as_given)?;
     let mut ranking = ranking;
     let mut found = None;
     // A recording that cannot be this motor gets no physics named, by the library or the
@@ -215,7 +216,6 @@ pub fn assemble(
     if !selected_fit.added.is_empty() {
         bases.push(&none);
     }
-    let proposals = law_proposals(problem, &selected_fit, &none)?;
     let named_fit = match &left {
         Some(verdict) => fit_named_terms(
             problem,
@@ -226,7 +226,13 @@ pub fn assemble(
         )?,
         None => None,
     };
-    let proposed_fit = fit_named_terms(problem, &proposals, &[&none], &selected_fit, allowed)?;
+    // Where nothing was selected the verdict holds these laws already.
+    let proposed_fit = if selected_fit.added.is_empty() {
+        None
+    } else {
+        let laws = as_given.fingerprints();
+        fit_named_terms(problem, laws, &[&none], &selected_fit, allowed)?
+    };
     let best = [named_fit, proposed_fit]
         .into_iter()
         .flatten()
@@ -239,7 +245,7 @@ pub fn assemble(
             ranking.push(selected_fit.clone());
             ranking.sort_by(|a, b| b.score.total_cmp(&a.score));
         }
-        left = unexplained(problem, &selected_fit, &none)?;
+        left = unexplained(problem, &selected_fit, &none, &as_given)?;
     }
     let passed_over: Vec<PassedOver> = passed_over
         .iter()

@@ -65,6 +65,19 @@ pub enum Fingerprint {
 }
 
 impl Fingerprint {
+    /// The same estimate scored `shift` nats lower (against a bar raised by `shift`).
+    pub(super) fn shifted(mut self, shift: f64) -> Self {
+        match &mut self {
+            Fingerprint::Oscillation { score, .. }
+            | Fingerprint::Delay { score, .. }
+            | Fingerprint::Lag { score, .. }
+            | Fingerprint::State { score, .. }
+            | Fingerprint::Drift { score, .. }
+            | Fingerprint::Unknown { score } => *score -= shift,
+        }
+        self
+    }
+
     pub fn score(&self) -> f64 {
         match self {
             Fingerprint::Oscillation { score, .. }

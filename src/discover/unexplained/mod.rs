@@ -411,29 +411,40 @@ fn spans(ctx: &Context, c: usize, e: &Explained) -> Vec<Span> {
 }
 
 /// The laws the model as given asks for: its state and drift fingerprints (functions chosen by
-/// evidence against the model without terms), whatever the selected terms gained. A law whose
-/// effect is large is underestimated by its first-order gain (its sensitivities are taken at
-/// zero coefficients), so the verdict, which compares that gain with what the selected terms
-/// gained, can miss a law that fits better than a library term standing in for it (a supply
-/// sagging with the charge taken as three library terms); these are fitted through the ODE
-/// and the fits decide (`named::fit_named_terms`). None where nothing was selected: the
-/// verdict holds the same fingerprints then.
-pub fn law_proposals(
-    problem: &Problem,
-    selected: &Candidate,
-    none: &Candidate,
-) -> Result<Vec<Fingerprint>, Error> {
-    if problem.recordings.is_empty() || selected.added.is_empty() {
-        return Ok(Vec::new());
+/// evidence against the model without terms), scored on it alone. Computed once per diagnosis
+/// (a sensitivity solve per law block): the verdict scores them against what the selected
+/// terms gained, and they are fitted through the ODE in place of the selected terms
+/// (`named::fit_named_terms`), because a law whose effect is large is underestimated by its
+/// first-order gain (its sensitivities are taken at zero coefficients) and could otherwise lose
+/// to a library term standing in for it (a supply sagging with the charge taken as three
+/// library terms) without ever being fitted.
+pub struct AsGivenLaws(Vec<Evidence>);
+
+impl AsGivenLaws {
+    /// The laws of `none` (the model as given at its MAP, first record).
+    pub fn of(problem: &Problem, none: &Candidate) -> Result<Self, Error> {
+        if problem.recordings.is_empty() {
+            return Ok(Self(Vec::new()));
+        }
+        let ctx = Context::of(problem, none, 0)?;
+        if ctx.n < 20 {
+            return Ok(Self(Vec::new()));
+        }
+        Ok(Self(state::fingerprints(none, &ctx, 0.0)?))
     }
-    let ctx = Context::of(problem, none, 0)?;
-    if ctx.n < 20 {
-        return Ok(Vec::new());
+
+    pub fn fingerprints(&self) -> impl Iterator<Item = &Fingerprint> {
+        self.0.iter().map(|e| &e.fingerprint)
     }
-    Ok(state::fingerprints(none, &ctx, 0.0)?
-        .into_iter()
-        .map(|e| e.fingerprint)
-        .collect())
+
+    /// Each scored against a bar raised by `shift` nats.
+    fn shifted(&self, shift: f64) -> impl Iterator<Item = Evidence> + '_ {
+        self.0.iter().map(move |e| Evidence {
+            fingerprint: e.fingerprint.clone().shifted(shift),
+            residual: e.residual.clone(),
+            explained: e.explained.clone(),
+        })
+    }
 }
 
 /// The verdict on the first record: `None` when the selected model leaves nothing a generic
@@ -442,6 +453,7 @@ pub fn unexplained(
     problem: &Problem,
     selected: &Candidate,
     none: &Candidate,
+    as_given: &AsGivenLaws,
 ) -> Result<Option<Unexplained>, Error> {
     if problem.recordings.is_empty() {
         return Ok(None);
@@ -451,9 +463,11 @@ pub fn unexplained(
         return Ok(None);
     }
     let mut all = scores(&ctx, 0.0);
-    all.fingerprints
-        .extend(state::fingerprints(selected, &ctx, 0.0)?);
-    if !selected.added.is_empty() {
+    if selected.added.is_empty() {
+        all.fingerprints.extend(as_given.shifted(0.0));
+    } else {
+        all.fingerprints
+            .extend(state::fingerprints(selected, &ctx, 0.0)?);
         // What the selected terms gained over the model as given is the bar an alternative on
         // the model as given must clear to count against them. A law a library term absorbs
         // almost whole (Stribeck friction taken as Coulomb friction, a supply that sags with
@@ -462,8 +476,7 @@ pub fn unexplained(
         let none_ctx = Context::of(problem, none, 0)?;
         let on_none = scores(&none_ctx, shift);
         all.fingerprints.extend(on_none.fingerprints);
-        all.fingerprints
-            .extend(state::fingerprints(none, &none_ctx, shift)?);
+        all.fingerprints.extend(as_given.shifted(shift));
     }
     let best_generic = all
         .generic
