@@ -3,7 +3,7 @@
 
 use std::ops::Range;
 
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, DVector};
 
 /// A failed evaluation. Recoverable failures (an ODE that blew up, a step cap reached) reject
 /// the proposal like a divergence; fatal ones stop the run.
@@ -88,6 +88,55 @@ pub trait LogDensity {
     fn has_linear_coefficients(&self) -> bool {
         false
     }
+
+    /// Given the leading coordinates of `x` (θ; the rest is not read), the likelihood's
+    /// Gaussian structure in the others: per noise scale, its observations, the residual sum
+    /// of squares left after the least-squares coefficients, and those coefficients. `None`
+    /// where the density has no such structure; a recoverable error where θ is outside the
+    /// support or its solve fails. One plain solve at θ, which the density's next evaluation
+    /// at the same θ reuses.
+    fn linear_conditionals(&mut self, _x: &[f64]) -> Result<Option<Conditionals>, DensityError> {
+        Ok(None)
+    }
+
+    /// The number of leading coordinates [`linear_conditionals`](Self::linear_conditionals)
+    /// conditions on, without solving anything; `None` where it offers none.
+    fn conditioned_on(&self) -> Option<usize> {
+        None
+    }
+}
+
+/// The likelihood given θ, y = G(θ) + B·a + ε with ε ~ N(0, σ²I) per block: what
+/// [`LogDensity::linear_conditionals`] returns, and what `collapsed-is` draws σ and a from.
+#[derive(Clone, Debug)]
+pub struct Conditionals {
+    /// The coordinates before this index are θ; every block's coordinates come after it.
+    pub leading: usize,
+    pub blocks: Vec<LinearBlock>,
+}
+
+/// One noise scale σ (a recording's channel) and the coefficients that share it.
+#[derive(Clone, Debug)]
+pub struct LinearBlock {
+    /// The coordinate of log σ.
+    pub log_sigma: usize,
+    pub observations: usize,
+    /// ‖r − B·â‖² with r = y − G(θ): what no coefficient explains.
+    pub residual_ss: f64,
+    pub coefficients: Option<LinearCoefficients>,
+}
+
+/// The coefficients a of one block at their least-squares value given θ.
+#[derive(Clone, Debug)]
+pub struct LinearCoefficients {
+    /// The coordinate of a₁; the others follow it.
+    pub offset: usize,
+    /// â = (BᵀB)⁻¹Bᵀr.
+    pub least_squares: DVector<f64>,
+    /// L with BᵀB = LLᵀ (lower triangular).
+    pub gram_factor: DMatrix<f64>,
+    /// ∇log p(a) of the coefficients' prior at â: the conditional is tilted by it.
+    pub prior_slope: DVector<f64>,
 }
 
 /// ODE solves made: plain f64 solves, and dual-number solves with the number of derivative
@@ -217,6 +266,12 @@ impl<P: LogDensity> LogDensity for Counted<P> {
     }
     fn has_linear_coefficients(&self) -> bool {
         self.inner.has_linear_coefficients()
+    }
+    fn linear_conditionals(&mut self, x: &[f64]) -> Result<Option<Conditionals>, DensityError> {
+        self.inner.linear_conditionals(x)
+    }
+    fn conditioned_on(&self) -> Option<usize> {
+        self.inner.conditioned_on()
     }
 }
 

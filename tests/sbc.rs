@@ -470,6 +470,12 @@ fn laplace_is_ranks_the_truth_uniformly_in_100_replications() {
     calibration(&bm1(), 100, 10, SamplerKind::LaplaceIs);
 }
 
+/// On BM1 collapsed-is proposes θ and draws each σ from its InvGamma conditional given θ.
+#[test]
+fn collapsed_is_ranks_the_truth_uniformly_in_100_replications() {
+    calibration(&bm1(), 100, 10, SamplerKind::CollapsedIs);
+}
+
 /// Ten times Talts et al.'s 100: 1000 replications in 20 bins (50 expected per bin), which
 /// also sees a bias or a width error of a fraction of a posterior sd.
 #[test]
@@ -509,6 +515,12 @@ fn independence_ranks_the_truth_uniformly_on_bm2_k3_in_100_replications() {
 #[test]
 fn laplace_is_ranks_the_truth_uniformly_on_bm2_k3_in_100_replications() {
     calibration(&bm2_k3(), 100, 10, SamplerKind::LaplaceIs);
+}
+
+/// With the coefficients drawn from their conditional given θ and σ.
+#[test]
+fn collapsed_is_ranks_the_truth_uniformly_on_bm2_k3_in_100_replications() {
+    calibration(&bm2_k3(), 100, 10, SamplerKind::CollapsedIs);
 }
 
 /// The two replications of BM2(K = 3) whose independence chains mixed worst before the
@@ -567,6 +579,21 @@ fn on_bm2_k3_laplace_is_ranks_the_truth_uniformly_in_1000_replications() {
     write_report(
         "sbc_bm2_k3_laplace_is.txt",
         "cargo test --release --test sbc -- --ignored on_bm2_k3_laplace_is",
+        &report,
+    );
+}
+
+/// collapsed-is, 1000 replications in 20 bins on BM1 and on BM2(K = 3), written to
+/// papers/laplace-samplers/sbc_collapsed_is.txt.
+#[test]
+#[ignore]
+fn collapsed_is_ranks_the_truth_uniformly_in_1000_replications() {
+    let mut report = String::new();
+    report.push_str(&calibration(&bm1(), 1000, 20, SamplerKind::CollapsedIs));
+    report.push_str(&calibration(&bm2_k3(), 1000, 20, SamplerKind::CollapsedIs));
+    write_report(
+        "sbc_collapsed_is.txt",
+        "cargo test --release --test sbc -- --ignored --exact collapsed_is_ranks_the_truth_uniformly_in_1000_replications",
         &report,
     );
 }

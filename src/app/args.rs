@@ -133,6 +133,9 @@ impl ValueEnum for SamplerKind {
             SamplerKind::LaplaceIs => {
                 "Importance sampling from that Student-t, Pareto-smoothed; NUTS when k̂ > 0.7"
             }
+            SamplerKind::CollapsedIs => {
+                "Importance sampling with θ from that Student-t's marginal, σ and the discrepancy coefficients from their conditionals given θ; NUTS when k̂ > 0.7"
+            }
         };
         Some(PossibleValue::new(self.name()).help(help))
     }

@@ -265,7 +265,7 @@ pub fn format_table(records: &[BenchRecord]) -> String {
         let laplace = |r: &&&BenchRecord| {
             matches!(
                 r.sampler.parse::<SamplerKind>(),
-                Ok(SamplerKind::Independence | SamplerKind::LaplaceIs)
+                Ok(SamplerKind::Independence | SamplerKind::LaplaceIs | SamplerKind::CollapsedIs)
             )
         };
         for new in here.iter().filter(laplace) {

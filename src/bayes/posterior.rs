@@ -19,6 +19,8 @@ use crate::parameter::Prior;
 
 // The density, its gradient and the metrics: the loops over every channel at a point.
 mod evaluation;
+// The likelihood's Gaussian structure in σ and the coefficients given θ.
+mod conditional;
 
 const LN_2PI: f64 = 1.837_877_066_409_345_5;
 
@@ -36,6 +38,9 @@ struct Discrepancy {
     basis: DMatrix<f64>,
     /// BᵀB, for the metric.
     gram: DMatrix<f64>,
+    /// L with BᵀB = LLᵀ, for the coefficients' conditional given θ (`None` if B is rank
+    /// deficient).
+    gram_factor: Option<DMatrix<f64>>,
     offset: usize,
     priors: Vec<Prior>,
 }
@@ -315,6 +320,7 @@ impl CalibrationPosterior {
             ch.discrepancy = Some(Discrepancy {
                 description,
                 basis: b,
+                gram_factor: gram.clone().cholesky().map(|c| c.l()),
                 gram,
                 offset: next,
                 priors: (0..n)

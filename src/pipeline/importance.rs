@@ -3,11 +3,12 @@
 
 use std::time::Instant;
 
+use super::SamplerKind;
 use super::fallback::{falls_back, nuts_instead};
 use super::{Error, Fittable, PhaseCost, RunOutput, RunSettings, finish_run};
 use crate::density::DensityError;
 use crate::optimize::MapEstimate;
-use crate::sampler::importance::{NAME, importance_sample};
+use crate::sampler::importance::{collapsed_importance_sample, importance_sample};
 use crate::sampler::proposal::LaplaceProposal;
 
 /// The proposal's degrees of freedom and scale. Importance sampling has no acceptance rate to
@@ -18,9 +19,11 @@ pub const IS_SHAPE: (f64, f64) = (30.0, 1.0);
 
 /// Importance sampling of `posterior` from the Student-t at `map`: `chains × draws` proposals,
 /// resampled. Its `min_ess_bulk` is the smaller of the smoothed weights' ESS and the resampled
-/// draws' bulk ESS. When k̂ > `settings.fallback_above` (0.7 by default; or cannot be fitted) and `settings.fallback`, NUTS with a
-/// dense metric runs instead (`fallback::nuts_instead`); its record keeps k̂, says `fell_back`, and counts the
-/// importance sampling it replaced in its warm-up.
+/// draws' bulk ESS. With `collapsed-is` the Student-t is the Laplace approximation's marginal in
+/// θ and the rest is drawn from the posterior's conditionals given θ. When k̂ >
+/// `settings.fallback_above` (0.7 by default; or cannot be fitted) and `settings.fallback`, NUTS
+/// with a dense metric runs instead (`fallback::nuts_instead`); its record keeps k̂, says
+/// `fell_back`, and counts the importance sampling it replaced in its warm-up.
 pub(super) fn laplace_is<P: Fittable>(
     posterior: &P,
     map: &MapEstimate,
@@ -29,9 +32,19 @@ pub(super) fn laplace_is<P: Fittable>(
     label: &str,
     started: Instant,
 ) -> Result<RunOutput, Error> {
-    let proposal = LaplaceProposal::new(&map.x, &map.hessian)
-        .and_then(|p| p.with_shape(IS_SHAPE.0, IS_SHAPE.1))
-        .map_err(Error::Numerical)?;
+    let collapsed = settings.sampler == SamplerKind::CollapsedIs;
+    let proposal = if collapsed {
+        let leading = posterior.conditioned_on().ok_or_else(|| {
+            Error::invalid(
+                "collapsed-is needs a posterior whose noise scales (and coefficients) have conditionals given θ",
+            )
+        })?;
+        marginal_proposal(map, leading)
+    } else {
+        LaplaceProposal::new(&map.x, &map.hessian)
+    }
+    .and_then(|p| p.with_shape(IS_SHAPE.0, IS_SHAPE.1))
+    .map_err(Error::Numerical)?;
     // The recentring corrects the offset of the scales' marginal from the joint mode under
     // many linear coefficients (BM2). Without them (BM1) the marginals that are off their mode
     // are skewed ones — a term near its bound — where a symmetric proposal moved to the mean
@@ -42,8 +55,13 @@ pub(super) fn laplace_is<P: Fittable>(
     } else {
         0
     };
+    let sample = if collapsed {
+        collapsed_importance_sample
+    } else {
+        importance_sample
+    };
     let work = || {
-        importance_sample(
+        sample(
             &proposal,
             settings.chains,
             recentring,
@@ -58,7 +76,7 @@ pub(super) fn laplace_is<P: Fittable>(
     let mut output = RunOutput {
         map: map_cost,
         khat: Some(khat),
-        ..finish_run(NAME, run.chains, map, started)
+        ..finish_run(settings.sampler.name(), run.chains, map, started)
     };
     output.min_ess_bulk = output.min_ess_bulk.min(weights_ess);
     if !falls_back(khat, settings, f64::INFINITY) {
@@ -66,4 +84,18 @@ pub(super) fn laplace_is<P: Fittable>(
     }
     let spent = output.warmup + output.sampling;
     nuts_instead(posterior, settings, label, khat, output.map, spent, started)
+}
+
+/// The Laplace approximation's marginal in the first `leading` coordinates: N(x̂_θ, (H⁻¹)_θθ).
+fn marginal_proposal(map: &MapEstimate, leading: usize) -> Result<LaplaceProposal, String> {
+    let covariance = map
+        .hessian
+        .clone()
+        .try_inverse()
+        .ok_or("the Hessian at the MAP is singular")?;
+    let block = covariance.view((0, 0), (leading, leading)).into_owned();
+    let precision = block
+        .try_inverse()
+        .ok_or("the marginal covariance of θ is singular")?;
+    LaplaceProposal::new(&map.x[..leading], &precision)
 }

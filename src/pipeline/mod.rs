@@ -275,7 +275,7 @@ pub fn run_sampler<P: Fittable>(
     let map_cost = PhaseCost::counted(map_watch.elapsed(), &counted);
     let label = format!("{label} {}", settings.sampler.name());
     match settings.sampler {
-        SamplerKind::LaplaceIs => {
+        SamplerKind::LaplaceIs | SamplerKind::CollapsedIs => {
             return importance::laplace_is(posterior, &map, map_cost, settings, &label, started);
         }
         SamplerKind::Independence => {
@@ -322,9 +322,11 @@ fn dispatch<P: Fittable>(
                 MalaAdaptation::step_size_only(),
             ))
         })?)),
-        SamplerKind::LaplaceIs | SamplerKind::Independence => Err(Error::invalid(
-            "the Laplace samplers judge their proposals by k̂: run_sampler sends them to their own paths",
-        )),
+        SamplerKind::LaplaceIs | SamplerKind::CollapsedIs | SamplerKind::Independence => {
+            Err(Error::invalid(
+                "the Laplace samplers judge their proposals by k̂: run_sampler sends them to their own paths",
+            ))
+        }
         SamplerKind::FisherMala => Ok(outputs(execute(posterior, inits, settings, label, |_| {
             let step = 1.65 * (map.x.len() as f64).powf(-1.0 / 3.0);
             Ok((

@@ -36,6 +36,9 @@ pub enum SamplerKind {
     /// Importance sampling from the same Student-t, Pareto-smoothed, resampled to equal
     /// weights; falls back to NUTS when k̂ > 0.7.
     LaplaceIs,
+    /// Importance sampling with θ from the Student-t's marginal and the noise scales and
+    /// discrepancy coefficients from their conditionals given θ; NUTS when k̂ > 0.7.
+    CollapsedIs,
 }
 
 impl SamplerKind {
@@ -51,6 +54,7 @@ impl SamplerKind {
             SamplerKind::FisherMala => "fisher-mala",
             SamplerKind::Independence => "independence",
             SamplerKind::LaplaceIs => "laplace-is",
+            SamplerKind::CollapsedIs => "collapsed-is",
         }
     }
 
@@ -61,6 +65,7 @@ impl SamplerKind {
                 | SamplerKind::AdaptiveMetropolis
                 | SamplerKind::Independence
                 | SamplerKind::LaplaceIs
+                | SamplerKind::CollapsedIs
         )
     }
 
@@ -75,7 +80,7 @@ impl SamplerKind {
         )
     }
 
-    pub const ALL: [SamplerKind; 10] = [
+    pub const ALL: [SamplerKind; 11] = [
         SamplerKind::Metropolis,
         SamplerKind::AdaptiveMetropolis,
         SamplerKind::Mala,
@@ -86,6 +91,7 @@ impl SamplerKind {
         SamplerKind::FisherMala,
         SamplerKind::Independence,
         SamplerKind::LaplaceIs,
+        SamplerKind::CollapsedIs,
     ];
 }
 
@@ -128,7 +134,7 @@ pub enum MetricAdaptation {
 pub fn default_warmup(sampler: SamplerKind, metric: MetricAdaptation) -> usize {
     match sampler {
         SamplerKind::Independence => crate::sampler::independence::INDEPENDENCE_WARMUP,
-        SamplerKind::LaplaceIs => crate::sampler::importance::IS_WARMUP,
+        SamplerKind::LaplaceIs | SamplerKind::CollapsedIs => crate::sampler::importance::IS_WARMUP,
         _ if sampler.is_hamiltonian() && metric == MetricAdaptation::Laplace => LAPLACE_WARMUP,
         _ => 1000,
     }

@@ -69,8 +69,33 @@ impl ImportanceRun {
 struct Block {
     x: Vec<Vec<f64>>,
     log_density: Vec<f64>,
+    /// log q of the coordinates drawn from the density's conditionals (`collapsed-is`; 0
+    /// where the proposal drew every coordinate).
+    log_completion: Vec<f64>,
     cost: PhaseCost,
 }
+
+/// What the Laplace proposal draws: every coordinate (`laplace-is`), or θ only, with the noise
+/// scales and linear coefficients drawn from the density's conditionals given θ
+/// ([`super::collapsed`], `collapsed-is`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Proposed {
+    Everything,
+    Leading,
+}
+
+impl Proposed {
+    /// The sampler's name in files and tables.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Proposed::Everything => NAME,
+            Proposed::Leading => COLLAPSED_NAME,
+        }
+    }
+}
+
+/// The collapsed sampler's name in files and tables.
+pub const COLLAPSED_NAME: &str = "collapsed-is";
 
 /// Rounds the warm-up's proposals are spread over. The first moves the centre most of the way
 /// from a sample weighed against the MAP's proposal; the second re-estimates it from draws
@@ -107,6 +132,55 @@ where
     P: LogDensity,
     F: Fn(usize) -> Result<P, DensityError> + Sync,
 {
+    sample_proposed(
+        proposal,
+        Proposed::Everything,
+        chains,
+        warmup,
+        draws,
+        seed,
+        make,
+    )
+}
+
+/// [`importance_sample`] with `proposal` over θ (the density's leading coordinates) and the
+/// rest drawn from the density's conditionals given θ: every weight then varies with θ alone.
+pub fn collapsed_importance_sample<P, F>(
+    proposal: &LaplaceProposal,
+    chains: usize,
+    warmup: usize,
+    draws: usize,
+    seed: u64,
+    make: F,
+) -> Result<ImportanceRun, DensityError>
+where
+    P: LogDensity,
+    F: Fn(usize) -> Result<P, DensityError> + Sync,
+{
+    sample_proposed(
+        proposal,
+        Proposed::Leading,
+        chains,
+        warmup,
+        draws,
+        seed,
+        make,
+    )
+}
+
+fn sample_proposed<P, F>(
+    proposal: &LaplaceProposal,
+    proposed: Proposed,
+    chains: usize,
+    warmup: usize,
+    draws: usize,
+    seed: u64,
+    make: F,
+) -> Result<ImportanceRun, DensityError>
+where
+    P: LogDensity,
+    F: Fn(usize) -> Result<P, DensityError> + Sync,
+{
     if chains == 0 || draws == 0 {
         return Err(DensityError::fatal("importance sampling needs draws"));
     }
@@ -132,7 +206,7 @@ where
         let blocks: Vec<Block> = rngs
             .par_iter_mut()
             .enumerate()
-            .map(|(c, rng)| propose(&parts, make(c)?, rng))
+            .map(|(c, rng)| propose(&parts, proposed, make(c)?, rng))
             .collect::<Result<_, _>>()?;
         components[0].1 += defensive * chains;
         if n > defensive {
@@ -165,7 +239,7 @@ where
         .map(|(c, picks)| {
             let mut out = ChainOutput {
                 chain: c,
-                sampler: NAME.into(),
+                sampler: proposed.name().into(),
                 names: names.clone(),
                 draws: Vec::with_capacity(draws),
                 unconstrained: Vec::with_capacity(draws),
@@ -224,10 +298,14 @@ fn add_component(components: &mut Vec<(LaplaceProposal, usize)>, q: &LaplaceProp
 /// log π(x) − log Σᵣ (nᵣ/N) qᵣ(x) for every proposal so far: each weighed against the mixture of
 /// all rounds' proposals (with one round, exactly log π − log q).
 fn log_weights(rounds: &[Vec<Block>], components: &[(LaplaceProposal, usize)]) -> Vec<f64> {
+    let d = components[0].0.dim();
     let points = rounds.iter().flatten().flat_map(|b| {
-        b.x.iter()
-            .map(Vec::as_slice)
-            .zip(b.log_density.iter().copied())
+        b.x.iter().map(move |x| &x[..d]).zip(
+            b.log_density
+                .iter()
+                .zip(&b.log_completion)
+                .map(|(lp, lc)| lp - lc),
+        )
     });
     mixture_log_weights(points, components)
 }
@@ -278,7 +356,7 @@ fn recentre(current: &LaplaceProposal, rounds: &[Vec<Block>], smoothed: &Psis) -
         .iter()
         .flatten()
         .flat_map(|b| b.x.iter())
-        .map(|x| current.whiten(x))
+        .map(|x| current.whiten(&x[..current.dim()]))
         .collect();
     let d = current.dim();
     let mut mean = DVector::zeros(d);
@@ -312,9 +390,11 @@ fn recentre(current: &LaplaceProposal, rounds: &[Vec<Block>], smoothed: &Psis) -
     current.recentred(&current.unwhiten(&shift))
 }
 
-/// One chain's block of a round: `n` draws from each `(proposal, n)` part in turn.
+/// One chain's block of a round: `n` draws from each `(proposal, n)` part in turn, completed
+/// from the density's conditionals where only θ is `proposed`.
 fn propose<P: LogDensity>(
     parts: &[(&LaplaceProposal, usize)],
+    proposed: Proposed,
     density: P,
     rng: &mut super::ChainRng,
 ) -> Result<Block, DensityError> {
@@ -324,14 +404,33 @@ fn propose<P: LogDensity>(
     let mut block = Block {
         x: Vec::with_capacity(draws),
         log_density: Vec::with_capacity(draws),
+        log_completion: Vec::with_capacity(draws),
         cost: PhaseCost::default(),
     };
     let each = parts.iter().flat_map(|&(q, n)| std::iter::repeat_n(q, n));
     for proposal in each {
-        let x = proposal.draw(rng);
-        let lp = proposal_log_density(&mut density, &x)?;
+        let lead = proposal.draw(rng);
+        let (x, lp, lc) = match proposed {
+            Proposed::Everything => {
+                let lp = proposal_log_density(&mut density, &lead)?;
+                (lead, lp, 0.0)
+            }
+            Proposed::Leading => match super::collapsed::complete(&mut density, &lead, rng)? {
+                Some((x, lc)) => {
+                    let lp = proposal_log_density(&mut density, &x)?;
+                    (x, lp, lc)
+                }
+                // Nothing to condition on at θ: it weighs nothing.
+                None => {
+                    let mut x = lead;
+                    x.resize(density.dim(), 0.0);
+                    (x, f64::NEG_INFINITY, 0.0)
+                }
+            },
+        };
         block.x.push(x);
         block.log_density.push(lp);
+        block.log_completion.push(lc);
     }
     block.cost = PhaseCost::counted(watch.elapsed(), &density);
     Ok(block)

@@ -8,6 +8,7 @@
 pub mod adapt;
 pub mod adaptive_metropolis;
 pub mod clock;
+pub mod collapsed;
 pub mod cost;
 pub mod driver;
 pub mod fisher_mala;

@@ -202,3 +202,97 @@ impl crate::density::StartingPoint for Banana {
         Ok(vec![0.3, 0.0])
     }
 }
+
+/// Bayesian linear regression y = θ·g + B·a + ε, ε ~ N(0, σ²I), with flat priors on θ, a and σ,
+/// in the coordinates (θ, log σ, a): θ stands for a physical parameter, a for the discrepancy's
+/// coefficients. Its posterior is known in closed form (Normal–InvGamma): σ² ~ InvGamma((n − p
+/// − 1)/2, S/2) and (θ, a) | σ² ~ N(β̂, σ²(XᵀX)⁻¹) with X = [g B], p = 1 + k, β̂ and S the least
+/// squares' coefficients and residual sum of squares.
+#[derive(Clone, Debug)]
+pub struct LinearRegression {
+    pub g: DVector<f64>,
+    pub basis: DMatrix<f64>,
+    pub y: DVector<f64>,
+}
+
+impl LinearRegression {
+    fn design(&self) -> DMatrix<f64> {
+        let (n, k) = self.basis.shape();
+        DMatrix::from_fn(n, k + 1, |i, j| {
+            if j == 0 {
+                self.g[i]
+            } else {
+                self.basis[(i, j - 1)]
+            }
+        })
+    }
+
+    /// β̂ = (θ̂, â), (XᵀX)⁻¹ and S.
+    pub fn least_squares(&self) -> (DVector<f64>, DMatrix<f64>, f64) {
+        let x = self.design();
+        let inverse = (x.transpose() * &x).try_inverse().expect("full rank");
+        let beta = &inverse * x.transpose() * &self.y;
+        let s = (&self.y - x * &beta).norm_squared();
+        (beta, inverse, s)
+    }
+}
+
+impl LogDensity for LinearRegression {
+    fn dim(&self) -> usize {
+        2 + self.basis.ncols()
+    }
+    fn parameter_names(&self) -> Vec<String> {
+        let mut names = vec!["theta".to_string(), "log_sigma".to_string()];
+        names.extend((1..=self.basis.ncols()).map(|j| format!("a.{j}")));
+        names
+    }
+    fn log_density(&mut self, x: &[f64]) -> Result<f64, DensityError> {
+        let n = self.y.len() as f64;
+        let a = DVector::from_column_slice(&x[2..]);
+        let r = &self.y - &self.g * x[0] - &self.basis * a;
+        // σ flat in σ: the density in log σ carries its Jacobian σ.
+        Ok(-(n - 1.0) * x[1] - 0.5 * r.norm_squared() * (-2.0 * x[1]).exp())
+    }
+    fn log_density_and_gradient(
+        &mut self,
+        _x: &[f64],
+        _grad: &mut [f64],
+    ) -> Result<f64, DensityError> {
+        Err(DensityError::fatal(
+            "no gradient: a target for gradient-free samplers",
+        ))
+    }
+    fn linear_conditionals(
+        &mut self,
+        x: &[f64],
+    ) -> Result<Option<crate::density::Conditionals>, DensityError> {
+        let r = &self.y - &self.g * x[0];
+        let l = (self.basis.transpose() * &self.basis)
+            .cholesky()
+            .expect("full rank")
+            .l();
+        let projected = self.basis.tr_mul(&r);
+        let least_squares = l
+            .tr_solve_lower_triangular(&l.solve_lower_triangular(&projected).unwrap())
+            .unwrap();
+        let residual_ss = r.norm_squared() - least_squares.dot(&projected);
+        let k = self.basis.ncols();
+        Ok(Some(crate::density::Conditionals {
+            leading: 1,
+            blocks: vec![crate::density::LinearBlock {
+                log_sigma: 1,
+                observations: self.y.len(),
+                residual_ss,
+                coefficients: Some(crate::density::LinearCoefficients {
+                    offset: 2,
+                    least_squares,
+                    gram_factor: l,
+                    prior_slope: DVector::zeros(k),
+                }),
+            }],
+        }))
+    }
+    fn conditioned_on(&self) -> Option<usize> {
+        Some(1)
+    }
+}

@@ -65,7 +65,7 @@ impl CalibrationPosterior {
 
     /// The priors of θ at the point's u, with θ itself written to `theta_x`; `None` where the
     /// density is zero.
-    fn theta_priors(&mut self, x: &[f64]) -> Option<Vec<PriorInU>> {
+    pub(super) fn theta_priors(&mut self, x: &[f64]) -> Option<Vec<PriorInU>> {
         let mut out = Vec::with_capacity(self.theta.len());
         for (k, t) in self.theta.iter().enumerate() {
             let at = t.at(x[k])?;
@@ -187,6 +187,17 @@ impl LogDensity for CalibrationPosterior {
     /// BM2: the discrepancy's coefficients.
     fn has_linear_coefficients(&self) -> bool {
         self.discrepancy_description().is_some()
+    }
+
+    fn linear_conditionals(
+        &mut self,
+        x: &[f64],
+    ) -> Result<Option<crate::density::Conditionals>, DensityError> {
+        self.conditionals_at(x).map(Some)
+    }
+
+    fn conditioned_on(&self) -> Option<usize> {
+        Some(self.n_theta())
     }
 }
 
