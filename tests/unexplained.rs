@@ -147,7 +147,8 @@ fn a_recording_of_the_model_itself_leaves_nothing_unexplained() {
 
 /// With the whole library (the dynamic terms included, as `diagnose` runs by default) the
 /// dynamic term is ranked from the verdict's estimate on the model as given (its start), taken
-/// by the ranking's threshold, its parameter lands within 30% of the truth, and nothing is left.
+/// by the ranking's threshold, its parameter lands within 30% of the truth, and nothing is left;
+/// the verdict on the model as given, in the report beside it, is of the truth's kind.
 fn named_and_explained(name: &str, term: &str, key: &str, truth_key: &str) {
     let (problem, answer) = fixture(name);
     let mut s = settings();
@@ -160,6 +161,14 @@ fn named_and_explained(name: &str, term: &str, key: &str, truth_key: &str) {
     assert!(within(estimate, truth, 0.3), "{estimate} vs {truth}");
     assert!(d.unexplained.is_none(), "{:?}", d.unexplained);
     assert!(!d.residual_mismatch);
+    // The verdict on the model as given, reported beside the term, fingerprinted the same
+    // physics.
+    let given = d
+        .unexplained_as_given
+        .as_ref()
+        .expect("the model as given leaves the effect");
+    let kind = serde_json::to_value(&given.fingerprint).unwrap()["kind"].clone();
+    assert_eq!(kind, answer["fingerprint"]["kind"], "{name}");
 }
 
 #[test]

@@ -11,6 +11,9 @@ for c in sorted(os.listdir(d)):
     a = json.load(open(f"{p}/answer.json")); r = json.load(open(f"{p}/report.json"))
     u = r.get("unexplained"); truth = a["fingerprint"]
     fp = u["fingerprint"] if u else None
+    # The verdict on the model as given (before any term): the fingerprint of the whole miss.
+    g = r.get("unexplained_as_given")
+    fp_given = g["fingerprint"] if g else None
     def show(f):
         if not f: return "—"
         k = f["kind"]
@@ -19,6 +22,8 @@ for c in sorted(os.listdir(d)):
             return f"oscillation {f['frequency_hz']:.1f} Hz on {f['channel']}, {'rings' if f['ringing'] else 'runs on'}" + (f", ζ {z:.3f}" if z is not None else "")
         if k == "delay": return f"delay {f['seconds']*1e3:.3f} ms"
         if k == "lag": return f"lag on {f['channel']} {f['seconds']*1e3:.3f} ms"
+        if k == "state": return f"state ({f['balance']}): {', '.join(x['name'] for x in f['functions'])}"
+        if k == "drift": return f"drift: {f['variable']}"
         return k
     def show_truth(t):
         k = t["kind"]
@@ -26,7 +31,7 @@ for c in sorted(os.listdir(d)):
         if k in ("delay", "lag"): return f"{k}{' on '+t['channel'] if k=='lag' else ''} {t['seconds']*1e3:.3f} ms"
         if k == "state": return f"state: {', '.join(t['functions'])}"
         return f"{k}: {t.get('variable','')}"
-    kind_right = bool(fp) and fp["kind"] == truth["kind"]
+    kind_right = bool(fp_given) and fp_given["kind"] == truth["kind"]
     said_nothing = not u and not r["selected_set"]
     # The dynamic terms and the law are what a fingerprint names; any other selection with the
     # verdict null is a library term standing in for the effect.
@@ -37,12 +42,14 @@ for c in sorted(os.listdir(d)):
     t = tally.setdefault(key, [0, 0, 0, 0, 0])
     t[0] += 1; t[1] += bool(u); t[2] += kind_right; t[3] += by_fingerprint; t[4] += library_alone
     rows.append(f"| {c} | {a['type']} | {a['miss_nats']:.0f} | {show_truth(truth)} | {' + '.join(r['selected_set']) or 'none'} | "
-                f"{'%+.1f' % u['evidence'] if u else 'null'} | {show(fp)} | {'nothing missing found' if said_nothing else ''} |")
-print("| case | type | miss (nats) | truth | selected | unexplained | fingerprint | |")
-print("|---|---|---|---|---|---|---|---|")
+                f"{'%+.1f' % u['evidence'] if u else 'null'} | {show(fp)} | {show(fp_given)} | {'nothing missing found' if said_nothing else ''} |")
+print("| case | type | miss (nats) | truth | selected | unexplained | fingerprint | fingerprint of the model as given | |")
+print("|---|---|---|---|---|---|---|---|---|")
 print("\n".join(rows))
 print()
-print("| effect | cases | unexplained not null after | its kind right | a dynamic term or law selected | a library term alone, verdict null |")
+print("| effect | cases | unexplained not null after | the model as given's fingerprint of the right kind | a dynamic term or law selected | a library term alone, verdict null |")
 print("|---|---|---|---|---|---|")
 for k, (n, u, kr, fp, lib) in sorted(tally.items()):
     print(f"| {k} | {n} | {u} | {kr} | {fp} | {lib} |")
+n = sum(t[0] for t in tally.values()); kr = sum(t[2] for t in tally.values())
+print(f"\nfingerprint of the model as given of the truth's kind: {kr} of {n}")

@@ -198,11 +198,26 @@ fn write_figures(
         crate::plot::missing_torque(&path, &plot).map_err(|e| AppError::Output(e.to_string()))?;
         outputs.push(path.display().to_string());
     }
-    if let Some(u) = &diagnosis.unexplained {
-        let path = out.join("unexplained.png");
-        crate::plot::unexplained(&path, &unexplained_plot(u))
-            .map_err(|e| AppError::Output(e.to_string()))?;
-        outputs.push(path.display().to_string());
+    // The verdict after the selection, and on the model as given: the evidence behind the
+    // fingerprint of what is left, and of the whole mismatch that the named terms took up.
+    for (verdict, name, model) in [
+        (
+            &diagnosis.unexplained,
+            "unexplained.png",
+            "the selected model",
+        ),
+        (
+            &diagnosis.unexplained_as_given,
+            "unexplained_as_given.png",
+            "the model as given",
+        ),
+    ] {
+        if let Some(u) = verdict {
+            let path = out.join(name);
+            crate::plot::unexplained(&path, &unexplained_plot(u, model))
+                .map_err(|e| AppError::Output(e.to_string()))?;
+            outputs.push(path.display().to_string());
+        }
     }
     diagnosis.outputs.extend(outputs);
     Ok(())
@@ -210,7 +225,8 @@ fn write_figures(
 
 /// The verdict's evidence as figure rows: each channel's residual with what the leading
 /// fingerprint explains of it, then each channel's spectrum of gains.
-fn unexplained_plot(u: &crate::discover::Unexplained) -> crate::plot::UnexplainedPlot {
+/// The figure of a verdict on `model` ("the selected model", "the model as given").
+fn unexplained_plot(u: &crate::discover::Unexplained, model: &str) -> crate::plot::UnexplainedPlot {
     let f = &u.figure;
     let n = f.times.len();
     let lead = serde_json::to_value(&u.fingerprint)
@@ -224,7 +240,7 @@ fn unexplained_plot(u: &crate::discover::Unexplained) -> crate::plot::Unexplaine
             y_desc: format!("{name} residual [σ]"),
             x: f.times.clone(),
             points: f.residual[c * n..(c + 1) * n].to_vec(),
-            points_label: "residual of the selected model".into(),
+            points_label: format!("residual of {model}"),
             curve: f.explained[c * n..(c + 1) * n].to_vec(),
             curve_label: format!("what the fingerprint ({lead}) explains"),
         });
@@ -242,7 +258,7 @@ fn unexplained_plot(u: &crate::discover::Unexplained) -> crate::plot::Unexplaine
     }
     crate::plot::UnexplainedPlot {
         title: format!(
-            "left unexplained: {lead} ({:+.1} nats over the selected model)",
+            "left unexplained: {lead} ({:+.1} nats over {model})",
             u.evidence
         ),
         rows,
@@ -367,6 +383,15 @@ pub fn format_diagnosis(d: &Diagnosis) -> String {
                 w.channel, w.t_start, w.t_end
             );
         }
+    }
+    if let Some(g) = &d.unexplained_as_given {
+        let _ = writeln!(
+            s,
+            "the model as given: {:+.1} nats on {}, fingerprint {}",
+            g.evidence,
+            g.channels.join(" and "),
+            serde_json::to_string(&g.fingerprint).unwrap_or_default()
+        );
     }
     if let (Some(b), Some(a)) = (&d.fit_before, &d.fit_after) {
         let _ = writeln!(

@@ -82,6 +82,11 @@ pub struct Diagnosis {
     pub notes: Vec<String>,
     /// Structure the selected model leaves that no library term holds (`unexplained`).
     pub unexplained: Option<Unexplained>,
+    /// The verdict on the model as given, before any term is added: the fingerprint of the
+    /// whole mismatch, reported beside what was named so that a reader can see that the two
+    /// agree (a coupling named where the residual of the model as given rang, a law where it
+    /// followed the state). `null` where the model as given leaves nothing the verdict finds.
+    pub unexplained_as_given: Option<Unexplained>,
     /// The law term discovered from a state or drift fingerprint, when one was added.
     pub discovered: Option<Discovered>,
     /// True whenever `unexplained` is not null, or δ's band after the selected terms still
@@ -200,6 +205,11 @@ pub fn assemble(
     // asked again after it.
     let as_given = AsGivenLaws::of(problem, &none)?;
     let mut left = unexplained(problem, &selected_fit, &none, &as_given)?;
+    let left_as_given = if selected_fit.added.is_empty() {
+        left.clone()
+    } else {
+        unexplained(problem, &none, &none, &as_given)?
+    };
     let mut ranking = ranking;
     let mut found = None;
     // A recording that cannot be this motor gets no physics named, by the library or the
@@ -367,6 +377,7 @@ pub fn assemble(
         notes,
         residual_mismatch: left.is_some(),
         unexplained: left,
+        unexplained_as_given: left_as_given,
         discovered: found,
         convergence: BTreeMap::new(),
         threshold: EVIDENCE_THRESHOLD,
