@@ -10,7 +10,13 @@
 //! With `--diagnose N`, the first N records of each truth also go through the whole ranking
 //! (`discover` with `rank_only`, every library candidate) and the selected term is counted.
 //!
+//! The design is checked against the rest of the library (`design::separate_checked`): rivals
+//! that coincide with a candidate on the designed input join the candidates and the input is
+//! designed again (at most `RIVAL_ROUNDS` times); the records are then made from every final
+//! candidate as the truth. `--no-rival-check` designs for the named candidates only.
+//!
 //!   cargo run --release --example design_study -- separate DIR a,b [--records 20] [--diagnose N]
+//!       [--no-rival-check]
 //!
 //! Pinning, on the paper's model (c_g = 0.009, σ = 2 A and 10 rad/s): the design for R and
 //! c_g/J, then `--records` noisy records of the model on the designed and on the constant 24-V
@@ -32,8 +38,8 @@ use std::time::Instant;
 
 use motorcal::bayes::ModelSettings;
 use motorcal::design::{
-    self, Candidate, DesignSettings, Experiment, Limits, SearchSettings, Target, design_problem,
-    design_times,
+    self, Candidate, DesignSettings, Experiment, Limits, RIVAL_ROUNDS, SearchSettings, Target,
+    design_problem, design_times,
 };
 use motorcal::discover::{DiscoverSettings, EVIDENCE_THRESHOLD, discover, fit_candidate};
 use motorcal::io::{ModelFile, read_model_file};
@@ -70,11 +76,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             &args[2],
             records.unwrap_or(20),
             diagnosed,
+            !args.iter().any(|a| a == "--no-rival-check"),
         ),
         Some("pin") => pin(records.unwrap_or(30), sampler),
         _ => Err(
-            "usage: design_study separate DIR a,b [--records N] [--diagnose N] | pin \
-                  [--records N] [--posterior SAMPLER]"
+            "usage: design_study separate DIR a,b [--records N] [--diagnose N] \
+                  [--no-rival-check] | pin [--records N] [--posterior SAMPLER]"
                 .into(),
         ),
     }
@@ -111,11 +118,24 @@ fn values(diag: &serde_json::Value, name: &str) -> BTreeMap<String, f64> {
     out
 }
 
+/// `truth > rival (gap)` for each unseparated rival, or `none`.
+fn rivals(rivals: &[design::Rival]) -> String {
+    if rivals.is_empty() {
+        return "none".into();
+    }
+    rivals
+        .iter()
+        .map(|r| format!("{} > {} ({:.2})", r.truth, r.rival, r.expected_gap_nats))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
 fn separate(
     dir: PathBuf,
     pair: &str,
     records: usize,
     diagnosed: usize,
+    rival_check: bool,
 ) -> Result<(), Box<dyn std::error::Error>> {
     let model = read_model_file(&dir.join("motor.toml"))?;
     let diag: serde_json::Value =
@@ -133,7 +153,30 @@ fn separate(
         noise_sd: vec![2.0, 10.0],
     };
     let started = Instant::now();
-    let d = design::separate(&experiment, &settings()?)?;
+    let (d, experiment) = if rival_check {
+        let checked = design::separate_checked(&base, &experiment, &settings()?, RIVAL_ROUNDS)?;
+        for (i, round) in checked.rounds.iter().enumerate() {
+            println!(
+                "  round {}: candidates {:?}, expected gap {:.2} ± {:.2} nats; rivals within {} \
+                 nats: {}",
+                i + 1,
+                round.candidates,
+                round.expected_gap_nats,
+                round.spread_nats,
+                EVIDENCE_THRESHOLD,
+                rivals(&round.unseparated_rivals)
+            );
+            if let Some(note) = &round.note {
+                println!("    {note}");
+            }
+            if !round.not_fitted.is_empty() {
+                println!("    not fitted: {:?}", round.not_fitted);
+            }
+        }
+        (checked.design, checked.experiment)
+    } else {
+        (design::separate(&experiment, &settings()?)?, experiment)
+    };
     println!(
         "{pair}: designed expected gap {:.2} ± {:.2} nats (worst truth), {:.1} s",
         d.expected_gap_nats,

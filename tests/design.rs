@@ -9,6 +9,7 @@ use motorcal::design::{
     self, Candidate, DesignSettings, Experiment, Limits, SearchSettings, design_problem,
     design_times,
 };
+use motorcal::discover::EVIDENCE_THRESHOLD;
 use motorcal::io::{read_model_file, read_voltage_profile};
 use motorcal::motor::VoltageInput;
 use motorcal::study::{Problem, recording_from};
@@ -181,6 +182,11 @@ fn a_small_design_runs_end_to_end() {
     );
     assert!(json["peaks"]["I"].as_f64().unwrap() <= 300.0);
     assert!(out.join("design.png").exists());
+    // The rest of the library was checked on the designed input.
+    assert!(json["unseparated_rivals"].is_array());
+    let rounds = json["rival_check"]["rounds"].as_array().unwrap();
+    assert!((1..=1 + design::RIVAL_ROUNDS).contains(&rounds.len()));
+    assert_eq!(json["rival_check"]["threshold_nats"], EVIDENCE_THRESHOLD);
 
     // The loop closes: simulate takes the designed input.
     let sim = dir.join("sim");
@@ -378,4 +384,104 @@ fn design_fits_the_named_candidates_to_a_recording_when_no_diagnosis_is_given() 
     // The noise is the recording's, not the paper's 2 A and 10 rad/s to the digit.
     assert_ne!(json["noise_sd"]["I"], 2.0);
     assert!(json["expected_gap_nats"].is_f64());
+}
+
+/// Dd of the test's viscous friction [N·m·s/rad]: strong enough to be seen on 50 samples.
+const DD: f64 = 2e-4;
+
+/// Viscous friction against quadratic drag (as strong at 2000 rad/s) on the fixture's motor.
+fn friction_pair(times: &[f64]) -> (Problem, Experiment) {
+    let model = read_model_file(&fixture("motor.toml")).unwrap();
+    let base = design_problem(&model, times).unwrap();
+    let at = |pairs: &[(&str, f64)]| -> BTreeMap<String, f64> {
+        pairs.iter().map(|(k, v)| (k.to_string(), *v)).collect()
+    };
+    let candidates = vec![
+        Candidate::new(
+            &base,
+            "viscous_friction",
+            &at(&[("R", 0.1), ("viscous_friction.Dd", DD)]),
+        )
+        .unwrap(),
+        Candidate::new(
+            &base,
+            "quadratic_drag",
+            &at(&[("R", 0.1), ("quadratic_drag.k_q", DD / 2000.0)]),
+        )
+        .unwrap(),
+    ];
+    let experiment = Experiment {
+        candidates,
+        times: times.to_vec(),
+        noise_sd: vec![2.0, 10.0],
+    };
+    (base, experiment)
+}
+
+#[test]
+fn a_library_term_that_coincides_with_a_candidate_on_the_designed_input_is_found_and_separated() {
+    let times = design_times(0.1, 500.0).unwrap();
+    let (base, experiment) = friction_pair(&times);
+    let settings = DesignSettings {
+        search: SearchSettings {
+            segments: 4,
+            starts: 2,
+            iterations: 60,
+            seed: 3,
+        },
+        limits: "U=±24,I=±300,omega=±3000".parse().unwrap(),
+        draws: 2,
+    };
+    let is_asymmetric_on_viscous = |r: &design::Rival| {
+        r.truth == "viscous_friction"
+            && r.rival == "asymmetric_friction"
+            && r.expected_gap_nats <= EVIDENCE_THRESHOLD
+    };
+    // Checked but not redesigned: the pair's design leaves asymmetric friction (viscous
+    // friction wherever ω keeps one sign) within the threshold of viscous friction.
+    let once = design::separate_checked(&base, &experiment, &settings, 0).unwrap();
+    assert_eq!(once.rounds.len(), 1);
+    assert!(
+        once.unseparated_rivals()
+            .iter()
+            .any(is_asymmetric_on_viscous),
+        "{:?}",
+        once.rounds
+    );
+    assert!(once.added().is_empty());
+
+    let checked =
+        design::separate_checked(&base, &experiment, &settings, design::RIVAL_ROUNDS).unwrap();
+    let first = &checked.rounds[0];
+    assert!(
+        first
+            .unseparated_rivals
+            .iter()
+            .any(is_asymmetric_on_viscous),
+        "{:?}",
+        checked.rounds
+    );
+    // The rival joined the candidates, the input was designed again, and nothing is left.
+    assert_eq!(checked.added(), ["asymmetric_friction"]);
+    assert_eq!(checked.rounds.len(), 2, "{:?}", checked.rounds);
+    assert!(
+        checked.unseparated_rivals().is_empty(),
+        "{:?}",
+        checked.rounds
+    );
+    for g in &checked.design.gaps {
+        assert!(g.noise_free_gap_nats > EVIDENCE_THRESHOLD, "{g:?}");
+    }
+    // On the final input the pair's own check finds asymmetric friction beyond the threshold:
+    // the speed reverses there.
+    let input = design::held(&times, checked.design.values.clone());
+    let again =
+        design::check_rivals(&base, &experiment, &input, &["asymmetric_friction".into()]).unwrap();
+    assert!(again.rivals.is_empty(), "{:?}", again.rivals);
+    let viscous = &experiment.candidates[0];
+    let forward = viscous.forward(&input, &times).unwrap();
+    let mut y = vec![0.0; forward.n_outputs()];
+    forward.simulate(&viscous.theta, &mut y).unwrap();
+    let omega = &y[times.len()..];
+    assert!(omega.iter().any(|w| *w > 10.0) && omega.iter().any(|w| *w < -10.0));
 }

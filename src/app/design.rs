@@ -62,6 +62,12 @@ pub struct DesignArgs {
     /// Noisy records per candidate for the reported gap and its spread.
     #[arg(long, default_value_t = design::DEFAULT_DRAWS)]
     pub draws: usize,
+    /// Separate the named candidates only: skip the check of the rest of the library on the
+    /// designed input (by default a library term that comes within the ranking's tie threshold
+    /// of a candidate there joins the candidates and the input is designed again, at most
+    /// twice).
+    #[arg(long, conflicts_with = "pin")]
+    pub no_rival_check: bool,
     /// Output folder for input.csv, design.json and design.png.
     #[arg(long)]
     pub out: PathBuf,
@@ -178,7 +184,26 @@ pub fn run(args: &DesignArgs) -> Result<(), AppError> {
                 (candidates, source)
             }
         };
-        let at: BTreeMap<&str, BTreeMap<&str, f64>> = candidates
+        let experiment = Experiment {
+            candidates,
+            times: times.clone(),
+            noise_sd: noise_sd.clone(),
+        };
+        let (d, experiment, checked) = if args.no_rival_check {
+            (design::separate(&experiment, &settings)?, experiment, None)
+        } else {
+            let c = design::separate_checked(&base, &experiment, &settings, design::RIVAL_ROUNDS)?;
+            let check = json!({
+                "threshold_nats": crate::discover::EVIDENCE_THRESHOLD,
+                "library": c.library,
+                "added": c.added(),
+                "rounds": c.rounds,
+            });
+            let rivals = json!(c.unseparated_rivals());
+            (c.design, c.experiment, Some((rivals, check)))
+        };
+        let at: BTreeMap<&str, BTreeMap<&str, f64>> = experiment
+            .candidates
             .iter()
             .map(|c| {
                 let values = c
@@ -190,16 +215,14 @@ pub fn run(args: &DesignArgs) -> Result<(), AppError> {
                 (c.name.as_str(), values)
             })
             .collect();
-        let at = json!({"source": source, "values": at});
-        let experiment = Experiment {
-            candidates,
-            times: times.clone(),
-            noise_sd: noise_sd.clone(),
-        };
-        let d = design::separate(&experiment, &settings)?;
+        let mut at = json!({"source": source, "values": at});
+        if experiment.candidates.len() > names.len() {
+            at["added_source"] =
+                json!("each added rival at its fit to the truth it came closest to");
+        }
         let input = design::held(&d.times, d.values.clone());
         let curves = design::lead_curves(&experiment, &input)?;
-        let report = json!({
+        let mut report = json!({
             "objective": "separate",
             "candidates": names,
             "candidates_at": at,
@@ -213,6 +236,10 @@ pub fn run(args: &DesignArgs) -> Result<(), AppError> {
             })).collect::<Vec<_>>(),
             "profile": d.profile, "peaks": d.check.peaks,
         });
+        // Null where the check was skipped: not checked, which an empty list would not say.
+        let (rivals, check) = checked.unwrap_or((Value::Null, Value::Null));
+        report["unseparated_rivals"] = rivals;
+        report["rival_check"] = check;
         let (truth, rival) = (
             &experiment.candidates[curves.lead.truth].name,
             &experiment.candidates[curves.lead.rival].name,
@@ -404,6 +431,69 @@ fn write_outputs(
     Ok(())
 }
 
+/// The rival check: each round's candidates, gap and unseparated rivals, then what is left.
+fn print_rivals(report: &Value) {
+    let check = &report["rival_check"];
+    if check.is_null() {
+        println!("rest of the library: not checked (--no-rival-check)");
+        return;
+    }
+    let threshold = check["threshold_nats"].as_f64().unwrap_or(f64::NAN);
+    let rounds = check["rounds"].as_array().map_or(&[][..], Vec::as_slice);
+    for (i, round) in rounds.iter().enumerate() {
+        let names: Vec<&str> = round["candidates"]
+            .as_array()
+            .into_iter()
+            .flatten()
+            .filter_map(Value::as_str)
+            .collect();
+        let rivals: Vec<String> = round["unseparated_rivals"]
+            .as_array()
+            .into_iter()
+            .flatten()
+            .map(|r| {
+                format!(
+                    "{} on {} ({:.2})",
+                    r["rival"].as_str().unwrap_or(""),
+                    r["truth"].as_str().unwrap_or(""),
+                    r["expected_gap_nats"].as_f64().unwrap_or(f64::NAN)
+                )
+            })
+            .collect();
+        println!(
+            "  round {}: {} → expected gap {:.2} nats; rivals within {threshold} nats: {}",
+            i + 1,
+            names.join(", "),
+            round["expected_gap_nats"].as_f64().unwrap_or(f64::NAN),
+            if rivals.is_empty() {
+                "none".into()
+            } else {
+                rivals.join(", ")
+            }
+        );
+        if let Some(note) = round["note"].as_str() {
+            println!("    {note}");
+        }
+    }
+    let rivals = report["unseparated_rivals"]
+        .as_array()
+        .map_or(&[][..], Vec::as_slice);
+    if rivals.is_empty() {
+        println!("rest of the library: no rival within {threshold} nats of any candidate");
+    } else {
+        println!("unseparated rivals (the design leaves them within {threshold} nats):");
+        println!("  {:<24} {:<24} {:>16}", "truth", "rival", "expected gap");
+        for r in rivals {
+            println!(
+                "  {:<24} {:<24} {:>16.2}",
+                r["truth"].as_str().unwrap_or(""),
+                r["rival"].as_str().unwrap_or(""),
+                r["expected_gap_nats"].as_f64().unwrap_or(f64::NAN)
+            );
+        }
+    }
+}
+
 fn print_summary(report: &Value, out: &Path) {
     let f = |v: &Value| v.as_f64().map_or("—".to_string(), |x| format!("{x:.2}"));
     if report["objective"] == "separate" {
@@ -422,6 +512,7 @@ fn print_summary(report: &Value, out: &Path) {
                 f(&g["noise_free_gap_nats"])
             );
         }
+        print_rivals(report);
         for e in report["fixed_experiments"].as_array().into_iter().flatten() {
             println!(
                 "{:>9} input: expected gap {} ± {} nats{}",

@@ -41,7 +41,10 @@ pub fn candidates_without_diagnosis(
 
 /// The calibrated parameters where a MAP search on `base` with `added` on starts: the model's
 /// values inside their supports, the prior's median for one on a bound.
-fn starting_values(base: &Problem, added: &[String]) -> Result<BTreeMap<String, f64>, Error> {
+pub(super) fn starting_values(
+    base: &Problem,
+    added: &[String],
+) -> Result<BTreeMap<String, f64>, Error> {
     let posterior = base.with_terms(added)?.posterior(&ModelSettings::bm1())?;
     Ok(posterior
         .calibrated()

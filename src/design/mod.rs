@@ -8,7 +8,8 @@
 //! The files: `profile` (the input and its free coordinates), `limits`, `experiment` (the
 //! candidates at their estimates, the sampling and σ), `fitted` (the candidates' estimates
 //! when no diagnosis gives them), `separate` and `pin` (the objectives),
-//! `search` (multi-start Nelder–Mead). Nothing here reads or writes a file: `app::design` does.
+//! `search` (multi-start Nelder–Mead), `rivals` (the rest of the library on a separating
+//! design's input, and the redesign with the rivals it finds). Nothing here reads or writes a file: `app::design` does.
 //!
 //! **Limits.** An input is judged on the noise-free predictions of every candidate at the
 //! record's samples: one whose |I| or |ω| passes its limit there is refused. The search runs on
@@ -22,6 +23,7 @@ mod fitted;
 mod limits;
 mod pin;
 mod profile;
+mod rivals;
 mod search;
 mod separate;
 
@@ -30,6 +32,10 @@ pub use fitted::candidates_without_diagnosis;
 pub use limits::Limits;
 pub use pin::{Pinned, Target, fisher, pin_candidate, pinned};
 pub use profile::{Profile, held};
+pub use rivals::{
+    CheckedSeparation, RIVAL_ROUNDS, Rival, RivalCheck, RivalRound, check_rivals, library,
+    separate_checked,
+};
 pub use search::SearchSettings;
 pub use separate::{
     Evaluation, ExpectedGap, Lead, LeadCurves, expected_gaps, lead_curves, noise_free_leads,

@@ -15,7 +15,7 @@ use crate::motor::VoltageInput;
 use crate::parameter::{ParameterSpec, Support};
 use crate::study::cases::oracle::levenberg_marquardt;
 
-use super::experiment::Experiment;
+use super::experiment::{Candidate, Experiment};
 use super::limits::Limits;
 
 /// A truth's noise-free lead over its best-fitting rival.
@@ -90,8 +90,6 @@ pub fn noise_free_leads(
     if excess > 0.0 {
         return Ok(Evaluation::Infeasible { excess });
     }
-    let weights = experiment.weights();
-    let ln_n = (experiment.n_observations() as f64).ln();
     let candidates = &experiment.candidates;
     let mut leads = Vec::new();
     let mut fits = Vec::new();
@@ -107,15 +105,7 @@ pub fn noise_free_leads(
                 row.push(truth.theta.clone());
                 continue;
             }
-            let forward = rival.forward(input, &experiment.times)?;
-            let specs = forward.calibrated_specs();
-            let (ss, theta) = if polish {
-                levenberg_marquardt(&forward, &specs, &truths[a], &weights, rival.theta.clone())?
-            } else {
-                gauss_newton(&forward, &specs, &truths[a], &weights, rival.theta.clone())?
-            };
-            let d = rival.theta.len() as f64 - truth.theta.len() as f64;
-            let gap = 0.5 * ss + 0.5 * d * ln_n;
+            let (gap, theta) = lead_over(experiment, input, &truths[a], truth, rival, polish)?;
             if gap < best.gap {
                 best = Lead {
                     truth: a,
@@ -129,6 +119,31 @@ pub fn noise_free_leads(
         fits.push(row);
     }
     Ok(Evaluation::Feasible { leads, fits })
+}
+
+/// `rival` fitted to `target`, the noise-free prediction of `truth` under `input`, from the
+/// rival's estimate (weighted least squares at the experiment's σ: [`SEARCH_STEPS`]
+/// Gauss–Newton steps, or Levenberg–Marquardt to convergence with `polish`), and the truth's
+/// expected score lead over it, ½·SS/σ² + ½·(d_rival − d_truth)·ln N nats; with the fit.
+pub(super) fn lead_over(
+    experiment: &Experiment,
+    input: &VoltageInput,
+    target: &[f64],
+    truth: &Candidate,
+    rival: &Candidate,
+    polish: bool,
+) -> Result<(f64, Vec<f64>), Error> {
+    let weights = experiment.weights();
+    let ln_n = (experiment.n_observations() as f64).ln();
+    let forward = rival.forward(input, &experiment.times)?;
+    let specs = forward.calibrated_specs();
+    let (ss, theta) = if polish {
+        levenberg_marquardt(&forward, &specs, target, &weights, rival.theta.clone())?
+    } else {
+        gauss_newton(&forward, &specs, target, &weights, rival.theta.clone())?
+    };
+    let d = rival.theta.len() as f64 - truth.theta.len() as f64;
+    Ok((0.5 * ss + 0.5 * d * ln_n, theta))
 }
 
 /// The reported gap of one truth: mean and spread over noisy records.
