@@ -1,4 +1,4 @@
-//! `discover` names the physics of two concealed cases the crate ships, so that a clone without
+//! `discover` names the physics of three concealed cases the crate ships, so that a clone without
 //! `../shared` still tests it (the development cases in `tests/diagnose_dev.rs` skip there).
 //! Rank-only: the ranking and the selection, no sampled fits; a few seconds a case.
 //!
@@ -67,4 +67,26 @@ fn discover_names_a_concealed_coulomb_friction() {
 #[test]
 fn discover_names_a_concealed_torque_constant_error() {
     names_the_concealed_effect("torque_constant");
+}
+
+/// The forward selection's rule read backwards: every selected term must still earn its
+/// threshold beside the others. On this two-effect case (`motorcal simulate --effect
+/// coulomb_friction,resistance_heating --conceal --seed 991002`, papers/diagnose-speed's set)
+/// the forward steps took viscous friction first, for part of both effects, then the two
+/// true terms; without viscous friction the score falls by less than the threshold, so it
+/// goes, and the selection is the truth.
+#[test]
+fn a_term_the_later_terms_make_redundant_is_dropped() {
+    let dir = case_dir("coulomb_friction+resistance_heating");
+    let problem = Problem::from_files(&[dir.join("recording.csv")], &dir.join("motor.toml"))
+        .expect("the case reads");
+    let mut settings = DiscoverSettings {
+        rank_only: true,
+        ..DiscoverSettings::default()
+    };
+    settings.run.quiet = true;
+    let diagnosis = discover(&problem, &settings).expect("discover runs");
+    let mut selected = diagnosis.selected_set.clone();
+    selected.sort();
+    assert_eq!(selected, ["coulomb_friction", "resistance_heating"]);
 }

@@ -186,9 +186,48 @@ pub fn forward_selection(
             _ => break,
         }
     }
+    let current = backward(problem, current, &starts)?;
     Ok(Selection {
         terms: current.added.clone(),
         fit: current,
         passed_over,
     })
+}
+
+/// The forward step's rule read backwards: every selected term must still raise the score by
+/// more than the threshold over the selection without it. A term taken early can be made
+/// redundant by the terms after it (a flexible dynamic term that absorbed part of two effects
+/// before each was named); the one whose removal costs least goes while that cost is within
+/// the threshold, and the rest are asked again.
+fn backward(
+    problem: &Problem,
+    mut current: Candidate,
+    starts: &super::candidate::Starts,
+) -> Result<Candidate, Error> {
+    while current.added.len() > 1 {
+        let sets: Vec<Vec<String>> = (0..current.added.len())
+            .map(|i| {
+                let mut added = current.added.clone();
+                added.remove(i);
+                added
+            })
+            .collect();
+        let fits = sets
+            .par_iter()
+            .map(|added| fit_candidate_started(problem, added, Some(&current), starts))
+            .collect::<Vec<_>>()
+            .into_iter()
+            .zip(&sets)
+            .filter_map(|(f, added)| kept(added, f).transpose())
+            .collect::<Result<Vec<_>, _>>()?;
+        let best = fits
+            .into_iter()
+            .filter(|f| f.coincidence.is_none())
+            .max_by(|a, b| a.score.total_cmp(&b.score));
+        match best {
+            Some(fit) if current.score - fit.score <= EVIDENCE_THRESHOLD => current = fit,
+            _ => break,
+        }
+    }
+    Ok(current)
 }
