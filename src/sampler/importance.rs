@@ -26,6 +26,10 @@
 //! draws do not depend on the thread count; the weights are smoothed together, and the
 //! resampling (systematic, then shuffled and dealt back into `chains` blocks) runs on a stream
 //! of its own.
+//!
+//! `collapsed-is` runs the same machinery with the proposal over θ only: each proposal's other
+//! coordinates are drawn from the density's conditionals given θ ([`super::collapsed`]), their
+//! log density is subtracted from the weight, and the mixture and the recentring see θ alone.
 
 use nalgebra::DVector;
 use rand::RngExt;
