@@ -26,7 +26,7 @@ use super::settings::{
 };
 use super::state::{StateFingerprint, fingerprint, reading};
 use super::ties::separating_input;
-use super::unexplained::{AsGivenLaws, Unexplained, unexplained};
+use super::unexplained::{AsGiven, Unexplained, unexplained};
 
 #[derive(Clone, Debug, Serialize)]
 pub struct RankEntry {
@@ -203,7 +203,7 @@ pub fn assemble(
     // The verdict after the library's selection; where its fingerprint names a dynamic term
     // that then fits better, the term joins (or replaces) the selection and the verdict is
     // asked again after it.
-    let as_given = AsGivenLaws::of(problem, &none)?;
+    let as_given = AsGiven::of(problem, &none)?;
     let mut left = unexplained(problem, &selected_fit, &none, &as_given)?;
     let left_as_given = if selected_fit.added.is_empty() {
         left.clone()

@@ -25,6 +25,7 @@
 //! than the threshold: then the kind is `unknown`. Others within the threshold of the leader
 //! are listed as alternatives.
 
+mod as_given;
 mod fingerprint;
 mod oscillation;
 mod regression;
@@ -44,6 +45,7 @@ use super::candidate::Candidate;
 use super::coincide::input_steps;
 use super::fits::MISMATCH_MIN_SHARE;
 use super::settings::EVIDENCE_THRESHOLD;
+pub use as_given::AsGiven;
 pub use fingerprint::{EquationTerm, Fingerprint, equation_with};
 use oscillation::Oscillation;
 use regression::{Explained, Projector, explain};
@@ -216,6 +218,7 @@ impl Context {
 }
 
 /// A generic alternative's result: the best polynomial or autoregression of a channel.
+#[derive(Clone)]
 struct Generic {
     channel: usize,
     polynomial: bool,
@@ -265,9 +268,23 @@ pub struct UnexplainedFigure {
 }
 
 /// Everything scored on one model's residuals: the fingerprints and the generic alternatives.
+#[derive(Clone)]
 struct Scores {
     fingerprints: Vec<Evidence>,
     generic: Vec<Generic>,
+}
+
+impl Scores {
+    /// Every score against a bar raised by `shift` nats: what `scores(ctx, shift)` gives.
+    fn shifted(mut self, shift: f64) -> Self {
+        for e in &mut self.fingerprints {
+            e.fingerprint = e.fingerprint.clone().shifted(shift);
+        }
+        for g in &mut self.generic {
+            g.scored.score -= shift;
+        }
+        self
+    }
 }
 
 /// A fingerprint with what it explains, and of which residual (whitened, stacked), for the
@@ -410,50 +427,13 @@ fn spans(ctx: &Context, c: usize, e: &Explained) -> Vec<Span> {
     out
 }
 
-/// The laws the model as given asks for: its state and drift fingerprints (functions chosen by
-/// evidence against the model without terms), scored on it alone. Computed once per diagnosis
-/// (a sensitivity solve per law block): the verdict scores them against what the selected
-/// terms gained, and they are fitted through the ODE in place of the selected terms
-/// (`named::fit_named_terms`), because a law whose effect is large is underestimated by its
-/// first-order gain (its sensitivities are taken at zero coefficients) and could otherwise lose
-/// to a library term standing in for it (a supply sagging with the charge taken as three
-/// library terms) without ever being fitted.
-pub struct AsGivenLaws(Vec<Evidence>);
-
-impl AsGivenLaws {
-    /// The laws of `none` (the model as given at its MAP, first record).
-    pub fn of(problem: &Problem, none: &Candidate) -> Result<Self, Error> {
-        if problem.recordings.is_empty() {
-            return Ok(Self(Vec::new()));
-        }
-        let ctx = Context::of(problem, none, 0)?;
-        if ctx.n < 20 {
-            return Ok(Self(Vec::new()));
-        }
-        Ok(Self(state::fingerprints(none, &ctx, 0.0)?))
-    }
-
-    pub fn fingerprints(&self) -> impl Iterator<Item = &Fingerprint> {
-        self.0.iter().map(|e| &e.fingerprint)
-    }
-
-    /// Each scored against a bar raised by `shift` nats.
-    fn shifted(&self, shift: f64) -> impl Iterator<Item = Evidence> + '_ {
-        self.0.iter().map(move |e| Evidence {
-            fingerprint: e.fingerprint.clone().shifted(shift),
-            residual: e.residual.clone(),
-            explained: e.explained.clone(),
-        })
-    }
-}
-
 /// The verdict on the first record: `None` when the selected model leaves nothing a generic
 /// alternative finds, by more than the threshold, on it or on the model as given.
 pub fn unexplained(
     problem: &Problem,
     selected: &Candidate,
     none: &Candidate,
-    as_given: &AsGivenLaws,
+    as_given: &AsGiven,
 ) -> Result<Option<Unexplained>, Error> {
     if problem.recordings.is_empty() {
         return Ok(None);
@@ -462,7 +442,11 @@ pub fn unexplained(
     if ctx.n < 20 {
         return Ok(None);
     }
-    let mut all = scores(&ctx, 0.0);
+    // With nothing selected the selected model is the model as given, scored once already.
+    let mut all = match as_given.scores(0.0) {
+        Some(s) if selected.added.is_empty() => s,
+        _ => scores(&ctx, 0.0),
+    };
     if selected.added.is_empty() {
         all.fingerprints.extend(as_given.shifted(0.0));
     } else {
@@ -473,8 +457,10 @@ pub fn unexplained(
         // almost whole (Stribeck friction taken as Coulomb friction, a supply that sags with
         // the charge taken as a back-EMF constant) shows best there.
         let shift = selected.score - none.score;
-        let none_ctx = Context::of(problem, none, 0)?;
-        let on_none = scores(&none_ctx, shift);
+        let on_none = match as_given.scores(shift) {
+            Some(s) => s,
+            None => scores(&Context::of(problem, none, 0)?, shift),
+        };
         all.fingerprints.extend(on_none.fingerprints);
         all.fingerprints.extend(as_given.shifted(shift));
     }

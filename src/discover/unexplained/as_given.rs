@@ -1,0 +1,63 @@
+//! The model as given, scored once per diagnosis: every verdict compares with it. Its laws —
+//! its state and drift fingerprints (functions chosen by evidence against the model without
+//! terms; a sensitivity solve per law block) — are scored against what the selected terms
+//! gained, and fitted through the ODE in place of the selected terms
+//! (`named::fit_named_terms`), because a law whose effect is large is underestimated by its
+//! first-order gain (its sensitivities are taken at zero coefficients) and could otherwise lose
+//! to a library term standing in for it (a supply sagging with the charge taken as three
+//! library terms) without ever being fitted. Its fingerprints and generic alternatives (the
+//! oscillation search the dearest of them) are the bar after a selection, and the verdict on
+//! the model as given itself (`unexplained_as_given`).
+
+use crate::error::Error;
+use crate::study::Problem;
+
+use super::super::candidate::Candidate;
+use super::{Context, Evidence, Fingerprint, Scores, scores, state};
+
+pub struct AsGiven {
+    laws: Vec<Evidence>,
+    /// `None` where the verdict is not asked (no recording, or fewer than 20 samples).
+    scores: Option<Scores>,
+}
+
+impl AsGiven {
+    /// `none` (the model as given at its MAP), first record.
+    pub fn of(problem: &Problem, none: &Candidate) -> Result<Self, Error> {
+        let nothing = Self {
+            laws: Vec::new(),
+            scores: None,
+        };
+        if problem.recordings.is_empty() {
+            return Ok(nothing);
+        }
+        let ctx = Context::of(problem, none, 0)?;
+        if ctx.n < 20 {
+            return Ok(nothing);
+        }
+        Ok(Self {
+            laws: state::fingerprints(none, &ctx, 0.0)?,
+            scores: Some(scores(&ctx, 0.0)),
+        })
+    }
+
+    /// The laws' fingerprints.
+    pub fn fingerprints(&self) -> impl Iterator<Item = &Fingerprint> {
+        self.laws.iter().map(|e| &e.fingerprint)
+    }
+
+    /// The laws, each scored against a bar raised by `shift` nats.
+    pub(super) fn shifted(&self, shift: f64) -> impl Iterator<Item = Evidence> + '_ {
+        self.laws.iter().map(move |e| Evidence {
+            fingerprint: e.fingerprint.clone().shifted(shift),
+            residual: e.residual.clone(),
+            explained: e.explained.clone(),
+        })
+    }
+
+    /// The fingerprints and generic alternatives on the model as given's residual, scored
+    /// against a bar raised by `shift` nats.
+    pub(super) fn scores(&self, shift: f64) -> Option<Scores> {
+        self.scores.clone().map(|s| s.shifted(shift))
+    }
+}
