@@ -8,7 +8,7 @@ use super::fallback::{falls_back, nuts_instead};
 use super::{Error, Fittable, PhaseCost, RunOutput, RunSettings, finish_run};
 use crate::density::DensityError;
 use crate::optimize::MapEstimate;
-use crate::sampler::importance::{collapsed_importance_sample, importance_sample};
+use crate::sampler::importance::{Proposed, importance_sample_with};
 use crate::sampler::proposal::LaplaceProposal;
 
 /// The proposal's degrees of freedom and scale. Importance sampling has no acceptance rate to
@@ -32,8 +32,12 @@ pub(super) fn laplace_is<P: Fittable>(
     label: &str,
     started: Instant,
 ) -> Result<RunOutput, Error> {
-    let collapsed = settings.sampler == SamplerKind::CollapsedIs;
-    let proposal = if collapsed {
+    let proposed = if settings.sampler == SamplerKind::CollapsedIs {
+        Proposed::Leading
+    } else {
+        Proposed::Everything
+    };
+    let proposal = if proposed == Proposed::Leading {
         let leading = posterior.conditioned_on().ok_or_else(|| {
             Error::invalid(
                 "collapsed-is needs a posterior whose noise scales (and coefficients) have conditionals given θ",
@@ -55,14 +59,10 @@ pub(super) fn laplace_is<P: Fittable>(
     } else {
         0
     };
-    let sample = if collapsed {
-        collapsed_importance_sample
-    } else {
-        importance_sample
-    };
     let work = || {
-        sample(
+        importance_sample_with(
             &proposal,
+            proposed,
             settings.chains,
             recentring,
             settings.chain.draws,

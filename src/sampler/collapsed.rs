@@ -120,7 +120,7 @@ mod tests {
     use super::*;
     use crate::density::LinearCoefficients;
     use crate::sampler::driver::chain_rng;
-    use crate::sampler::importance::collapsed_importance_sample;
+    use crate::sampler::importance::{Proposed, importance_sample_with};
     use crate::sampler::proposal::LaplaceProposal;
     use crate::sampler::targets::LinearRegression;
     use nalgebra::DMatrix;
@@ -190,8 +190,10 @@ mod tests {
                 .unwrap()
                 .with_shape(30.0, 1.0)
                 .unwrap();
-        let run =
-            collapsed_importance_sample(&proposal, 4, 0, 1000, 11, |_| Ok(target.clone())).unwrap();
+        let run = importance_sample_with(&proposal, Proposed::Leading, 4, 0, 1000, 11, |_| {
+            Ok(target.clone())
+        })
+        .unwrap();
         assert!(run.khat() < 0.5, "k̂ = {}", run.khat());
         // Only θ's marginal is approximated, and it is nearly the t: nearly every draw counts.
         assert!(run.weights_ess() > 3600.0, "ESS {}", run.weights_ess());
@@ -228,7 +230,9 @@ mod tests {
                 .build()
                 .unwrap()
                 .install(|| {
-                    collapsed_importance_sample(&proposal, 3, 40, 200, 9, |_| Ok(target.clone()))
+                    importance_sample_with(&proposal, Proposed::Leading, 3, 40, 200, 9, |_| {
+                        Ok(target.clone())
+                    })
                 })
                 .unwrap()
         };

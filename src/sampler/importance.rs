@@ -136,7 +136,7 @@ where
     P: LogDensity,
     F: Fn(usize) -> Result<P, DensityError> + Sync,
 {
-    sample_proposed(
+    importance_sample_with(
         proposal,
         Proposed::Everything,
         chains,
@@ -147,32 +147,10 @@ where
     )
 }
 
-/// [`importance_sample`] with `proposal` over θ (the density's leading coordinates) and the
-/// rest drawn from the density's conditionals given θ: every weight then varies with θ alone.
-pub fn collapsed_importance_sample<P, F>(
-    proposal: &LaplaceProposal,
-    chains: usize,
-    warmup: usize,
-    draws: usize,
-    seed: u64,
-    make: F,
-) -> Result<ImportanceRun, DensityError>
-where
-    P: LogDensity,
-    F: Fn(usize) -> Result<P, DensityError> + Sync,
-{
-    sample_proposed(
-        proposal,
-        Proposed::Leading,
-        chains,
-        warmup,
-        draws,
-        seed,
-        make,
-    )
-}
-
-fn sample_proposed<P, F>(
+/// [`importance_sample`] with what the proposal draws chosen: with [`Proposed::Leading`],
+/// `proposal` is over θ (the density's leading coordinates) and the rest is drawn from the
+/// density's conditionals given θ, so every weight varies with θ alone (`collapsed-is`).
+pub fn importance_sample_with<P, F>(
     proposal: &LaplaceProposal,
     proposed: Proposed,
     chains: usize,
