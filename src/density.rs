@@ -126,6 +126,44 @@ pub struct LinearBlock {
     pub coefficients: Option<LinearCoefficients>,
 }
 
+impl LinearBlock {
+    /// The block of the residual r = y − G(θ): with a basis B (BᵀB = LLᵀ, `gram_factor`) whose
+    /// coefficients sit from `offset`, their least-squares values â, the prior's slope
+    /// `slope(j, â_j)` at them, and ‖r − Bâ‖² = ‖r‖² − âᵀBᵀr (since Bᵀ(r − Bâ) = 0); without
+    /// one, ‖r‖². `None` where L is singular.
+    pub fn least_squares(
+        log_sigma: usize,
+        r: &DVector<f64>,
+        basis: Option<(usize, &DMatrix<f64>, &DMatrix<f64>)>,
+        slope: impl Fn(usize, f64) -> f64,
+    ) -> Option<Self> {
+        let mut residual_ss = r.norm_squared();
+        let coefficients = match basis {
+            None => None,
+            Some((offset, b, l)) => {
+                let projected = b.tr_mul(r);
+                let least_squares =
+                    l.tr_solve_lower_triangular(&l.solve_lower_triangular(&projected)?)?;
+                residual_ss -= least_squares.dot(&projected);
+                let prior_slope =
+                    DVector::from_fn(least_squares.len(), |j, _| slope(j, least_squares[j]));
+                Some(LinearCoefficients {
+                    offset,
+                    least_squares,
+                    gram_factor: l.clone(),
+                    prior_slope,
+                })
+            }
+        };
+        Some(Self {
+            log_sigma,
+            observations: r.len(),
+            residual_ss: residual_ss.max(0.0),
+            coefficients,
+        })
+    }
+}
+
 /// The coefficients a of one block at their least-squares value given θ.
 #[derive(Clone, Debug)]
 pub struct LinearCoefficients {

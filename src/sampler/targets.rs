@@ -271,25 +271,16 @@ impl LogDensity for LinearRegression {
             .cholesky()
             .expect("full rank")
             .l();
-        let projected = self.basis.tr_mul(&r);
-        let least_squares = l
-            .tr_solve_lower_triangular(&l.solve_lower_triangular(&projected).unwrap())
-            .unwrap();
-        let residual_ss = r.norm_squared() - least_squares.dot(&projected);
-        let k = self.basis.ncols();
+        let block = crate::density::LinearBlock::least_squares(
+            1,
+            &r,
+            Some((2, &self.basis, &l)),
+            |_, _| 0.0,
+        )
+        .expect("full rank");
         Ok(Some(crate::density::Conditionals {
             leading: 1,
-            blocks: vec![crate::density::LinearBlock {
-                log_sigma: 1,
-                observations: self.y.len(),
-                residual_ss,
-                coefficients: Some(crate::density::LinearCoefficients {
-                    offset: 2,
-                    least_squares,
-                    gram_factor: l,
-                    prior_slope: DVector::zeros(k),
-                }),
-            }],
+            blocks: vec![block],
         }))
     }
     fn conditioned_on(&self) -> Option<usize> {

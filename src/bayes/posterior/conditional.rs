@@ -6,7 +6,7 @@
 use nalgebra::DVector;
 
 use super::CalibrationPosterior;
-use crate::density::{Conditionals, DensityError, LinearBlock, LinearCoefficients};
+use crate::density::{Conditionals, DensityError, LinearBlock};
 
 impl CalibrationPosterior {
     /// Every channel's block at the θ in the leading coordinates of `x` (the rest is not read).
@@ -29,41 +29,21 @@ impl CalibrationPosterior {
             for (c, ch) in term.channels.iter().enumerate() {
                 let g = &term.current.outputs[c * m..(c + 1) * m];
                 let r = DVector::from_iterator(m, ch.observed.iter().zip(g).map(|(y, g)| y - g));
-                let mut residual_ss = r.norm_squared();
-                let coefficients = match &ch.discrepancy {
+                let basis = match &ch.discrepancy {
                     None => None,
                     Some(d) => {
                         let l = d.gram_factor.as_ref().ok_or_else(|| {
                             DensityError::fatal("the discrepancy basis is rank deficient")
                         })?;
-                        let projected = d.basis.tr_mul(&r);
-                        let least_squares = l
-                            .solve_lower_triangular(&projected)
-                            .and_then(|w| l.tr_solve_lower_triangular(&w))
-                            .ok_or_else(|| DensityError::fatal("singular Gram factor"))?;
-                        // ‖r − Bâ‖² = ‖r‖² − âᵀBᵀr, since Bᵀ(r − Bâ) = 0.
-                        residual_ss -= least_squares.dot(&projected);
-                        let prior_slope = DVector::from_iterator(
-                            least_squares.len(),
-                            d.priors
-                                .iter()
-                                .zip(least_squares.iter())
-                                .map(|(p, &a)| p.gradient(a)),
-                        );
-                        Some(LinearCoefficients {
-                            offset: d.offset,
-                            least_squares,
-                            gram_factor: l.clone(),
-                            prior_slope,
-                        })
+                        Some((d.offset, &d.basis, l))
                     }
                 };
-                blocks.push(LinearBlock {
-                    log_sigma: ch.log_sigma_index,
-                    observations: m,
-                    residual_ss: residual_ss.max(0.0),
-                    coefficients,
-                });
+                let priors = ch.discrepancy.as_ref().map(|d| &d.priors);
+                let block = LinearBlock::least_squares(ch.log_sigma_index, &r, basis, |j, a| {
+                    priors.map_or(0.0, |p| p[j].gradient(a))
+                })
+                .ok_or_else(|| DensityError::fatal("singular Gram factor"))?;
+                blocks.push(block);
             }
         }
         Ok(Conditionals { leading, blocks })
