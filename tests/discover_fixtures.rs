@@ -17,7 +17,7 @@
 
 use std::path::{Path, PathBuf};
 
-use motorcal::discover::{DiscoverSettings, discover};
+use motorcal::discover::{Diagnosis, DiscoverSettings, discover};
 use motorcal::study::Problem;
 
 fn case_dir(name: &str) -> PathBuf {
@@ -33,10 +33,8 @@ fn concealed_effect(dir: &Path) -> String {
     answer["effect"].as_str().expect("effect").to_owned()
 }
 
-fn names_the_concealed_effect(name: &str) {
-    let dir = case_dir(name);
-    let truth = concealed_effect(&dir);
-    assert_eq!(truth, name, "the case directory is named after its effect");
+/// `discover` rank-only on a case folder: the ranking and the selection, no sampled fits.
+fn rank_only(dir: &Path) -> Diagnosis {
     let problem = Problem::from_files(&[dir.join("recording.csv")], &dir.join("motor.toml"))
         .expect("the case reads");
     let mut settings = DiscoverSettings {
@@ -44,7 +42,14 @@ fn names_the_concealed_effect(name: &str) {
         ..DiscoverSettings::default()
     };
     settings.run.quiet = true;
-    let diagnosis = discover(&problem, &settings).expect("discover runs");
+    discover(&problem, &settings).expect("discover runs")
+}
+
+fn names_the_concealed_effect(name: &str) {
+    let dir = case_dir(name);
+    let truth = concealed_effect(&dir);
+    assert_eq!(truth, name, "the case directory is named after its effect");
+    let diagnosis = rank_only(&dir);
     let top: Vec<String> = diagnosis
         .ranking
         .iter()
@@ -77,15 +82,7 @@ fn discover_names_a_concealed_torque_constant_error() {
 /// goes, and the selection is the truth.
 #[test]
 fn a_term_the_later_terms_make_redundant_is_dropped() {
-    let dir = case_dir("coulomb_friction+resistance_heating");
-    let problem = Problem::from_files(&[dir.join("recording.csv")], &dir.join("motor.toml"))
-        .expect("the case reads");
-    let mut settings = DiscoverSettings {
-        rank_only: true,
-        ..DiscoverSettings::default()
-    };
-    settings.run.quiet = true;
-    let diagnosis = discover(&problem, &settings).expect("discover runs");
+    let diagnosis = rank_only(&case_dir("coulomb_friction+resistance_heating"));
     let mut selected = diagnosis.selected_set.clone();
     selected.sort();
     assert_eq!(selected, ["coulomb_friction", "resistance_heating"]);
