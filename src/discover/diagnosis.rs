@@ -186,6 +186,8 @@ pub fn assemble(
     candidates: &[String],
     ranking: Vec<Candidate>,
     selection: Selection,
+    as_given: AsGiven,
+    not_offered: Option<String>,
     started: Instant,
     [ranking_s, selection_s]: [f64; 2],
     progress: &impl Fn(Progress),
@@ -203,7 +205,6 @@ pub fn assemble(
     // The verdict after the library's selection; where its fingerprint names a dynamic term
     // that then fits better, the term joins (or replaces) the selection and the verdict is
     // asked again after it.
-    let as_given = AsGiven::of(problem, &none)?;
     let mut left = unexplained(problem, &selected_fit, &none, &as_given)?;
     let left_as_given = if selected_fit.added.is_empty() {
         left.clone()
@@ -271,7 +272,7 @@ pub fn assemble(
         .first()
         .cloned()
         .unwrap_or_else(|| "none".into());
-    let mut notes = Vec::new();
+    let mut notes: Vec<String> = not_offered.into_iter().collect();
     let mut ties = Vec::new();
     let mut tie_experiments = BTreeMap::new();
     // A discovered law has no rival in the library to be tied with: the ties are the

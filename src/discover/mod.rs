@@ -81,6 +81,7 @@ pub use unexplained::{Fingerprint, Span, Unexplained, UnexplainedFigure};
 use crate::bayes::ModelSettings;
 use crate::error::Error;
 use crate::study::Problem;
+use unexplained::{AsGiven, dynamic_starts, offered};
 
 /// The stages of a diagnosis, as [`discover_with`] reports them to its caller.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -133,10 +134,16 @@ pub fn discover_with(
     progress(Progress::Ranking {
         candidates: candidates.len(),
     });
-    let ranking = rank(problem, &candidates)?;
+    // The model as given and the verdict on its residual come first: they say where the
+    // dynamic terms start and whether a coupling has a resonance to be ranked on.
+    let none = fit_candidate(problem, &[])?;
+    let as_given = AsGiven::of(problem, &none)?;
+    let (candidates, not_offered) = offered(candidates, settings.candidates.is_some(), &as_given);
+    let starts = dynamic_starts(&as_given, &candidates);
+    let ranking = rank(problem, none, &candidates, &starts)?;
     let ranking_s = started.elapsed().as_secs_f64();
     progress(Progress::Selecting);
-    let selection = forward_selection(problem, &ranking, &candidates)?;
+    let selection = forward_selection(problem, &ranking, &candidates, &starts)?;
     let selection_s = started.elapsed().as_secs_f64();
     progress(Progress::Reporting);
     diagnosis::assemble(
@@ -146,6 +153,8 @@ pub fn discover_with(
         &candidates,
         ranking,
         selection,
+        as_given,
+        not_offered,
         started,
         [ranking_s, selection_s],
         &progress,

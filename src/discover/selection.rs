@@ -7,23 +7,25 @@ use rayon::prelude::*;
 use crate::error::Error;
 use crate::study::Problem;
 
-use super::candidate::{Candidate, fit_candidate, fit_candidate_started};
+use super::candidate::{Candidate, Starts, fit_candidate_started};
 use super::confirm::importance_evidence;
 use super::settings::{EVIDENCE_THRESHOLD, MAX_TERMS, uses_laplace};
 use super::state::records_reverse;
-use super::unexplained::{DYNAMIC, StepScreen, dynamic_starts};
+use super::unexplained::{DYNAMIC, StepScreen};
 
-/// Ranks `candidates` one at a time against the model without them, best first.
-/// Fits are deterministic and independent, so they run in parallel without changing a bit.
-/// The model as given is fitted first: the dynamic terms start where its residual says
-/// (`dynamic_starts`).
-pub fn rank(problem: &Problem, candidates: &[String]) -> Result<Vec<Candidate>, Error> {
-    let none = fit_candidate(problem, &[])?;
-    let starts = dynamic_starts(problem, &none, candidates)?;
+/// Ranks `candidates` one at a time against `none` (the model as given at its MAP), best
+/// first. Fits are deterministic and independent, so they run in parallel without changing a
+/// bit. The dynamic terms start where the residual of the model as given says (`starts`).
+pub fn rank(
+    problem: &Problem,
+    none: Candidate,
+    candidates: &[String],
+    starts: &Starts,
+) -> Result<Vec<Candidate>, Error> {
     let mut fits = vec![none];
     let fitted = candidates
         .par_iter()
-        .map(|c| fit_candidate_started(problem, std::slice::from_ref(c), None, &starts))
+        .map(|c| fit_candidate_started(problem, std::slice::from_ref(c), None, starts))
         .collect::<Vec<_>>();
     for (c, fit) in candidates.iter().zip(fitted) {
         if let Some(fit) = kept(std::slice::from_ref(c), fit)? {
@@ -84,6 +86,7 @@ pub fn forward_selection(
     problem: &Problem,
     ranking: &[Candidate],
     candidates: &[String],
+    starts: &Starts,
 ) -> Result<Selection, Error> {
     let none = ranking
         .iter()
@@ -97,7 +100,6 @@ pub fn forward_selection(
         .filter(|f| beats(f, &none))
         .cloned()
         .collect();
-    let starts = dynamic_starts(problem, &none, candidates)?;
     let best = ranking
         .iter()
         .find(|f| f.coincidence.is_none())
@@ -147,7 +149,7 @@ pub fn forward_selection(
                 !dear(name)
                     || screen
                         .as_ref()
-                        .is_none_or(|s| s.worth_fitting(&current, name, &starts))
+                        .is_none_or(|s| s.worth_fitting(&current, name, starts))
             })
             .map(|name| {
                 let mut added = current.added.clone();
@@ -157,7 +159,7 @@ pub fn forward_selection(
             .collect();
         let fits = sets
             .par_iter()
-            .map(|added| fit_candidate_started(problem, added, Some(&current), &starts))
+            .map(|added| fit_candidate_started(problem, added, Some(&current), starts))
             .collect::<Vec<_>>()
             .into_iter()
             .zip(&sets)
@@ -186,7 +188,7 @@ pub fn forward_selection(
             _ => break,
         }
     }
-    let current = backward(problem, current, &starts)?;
+    let current = backward(problem, current, starts)?;
     Ok(Selection {
         terms: current.added.clone(),
         fit: current,
@@ -202,7 +204,7 @@ pub fn forward_selection(
 fn backward(
     problem: &Problem,
     mut current: Candidate,
-    starts: &super::candidate::Starts,
+    starts: &Starts,
 ) -> Result<Candidate, Error> {
     while current.added.len() > 1 {
         let sets: Vec<Vec<String>> = (0..current.added.len())

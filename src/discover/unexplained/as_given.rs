@@ -13,12 +13,14 @@ use crate::error::Error;
 use crate::study::Problem;
 
 use super::super::candidate::Candidate;
-use super::{Context, Evidence, Fingerprint, Scores, scores, state};
+use super::{Context, Evidence, Fingerprint, Scores, oscillation, scores, state};
 
 pub struct AsGiven {
     laws: Vec<Evidence>,
     /// `None` where the verdict is not asked (no recording, or fewer than 20 samples).
     scores: Option<Scores>,
+    /// Below this frequency (Hz) an oscillation on the record is a trend.
+    lowest_frequency: f64,
 }
 
 impl AsGiven {
@@ -27,6 +29,7 @@ impl AsGiven {
         let nothing = Self {
             laws: Vec::new(),
             scores: None,
+            lowest_frequency: f64::INFINITY,
         };
         if problem.recordings.is_empty() {
             return Ok(nothing);
@@ -38,7 +41,33 @@ impl AsGiven {
         Ok(Self {
             laws: state::fingerprints(none, &ctx, 0.0)?,
             scores: Some(scores(&ctx, 0.0)),
+            lowest_frequency: oscillation::lowest_frequency(&ctx),
         })
+    }
+
+    /// The best score of a ringing oscillation of at least two periods over the record (nats,
+    /// its grid paid for): a resonance to be seen. `None` where there is none, or where the
+    /// verdict was not asked.
+    pub fn ringing_evidence(&self) -> Option<f64> {
+        self.scores
+            .as_ref()?
+            .fingerprints
+            .iter()
+            .filter(|e| match e.fingerprint {
+                Fingerprint::Oscillation {
+                    ringing: true,
+                    frequency_hz,
+                    ..
+                } => frequency_hz >= self.lowest_frequency,
+                _ => false,
+            })
+            .map(|e| e.fingerprint.score())
+            .max_by(f64::total_cmp)
+    }
+
+    /// Below this frequency (Hz) an oscillation on the record is a trend.
+    pub fn lowest_frequency(&self) -> f64 {
+        self.lowest_frequency
     }
 
     /// The laws' fingerprints.

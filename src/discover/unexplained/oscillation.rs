@@ -180,13 +180,18 @@ fn golden(lo: f64, hi: f64, mut g: impl FnMut(f64) -> f64) -> f64 {
     (a + b) / 2.0
 }
 
+/// The lowest frequency an oscillation is told from a trend at: below two periods over the
+/// record it is one (the polynomial's).
+pub fn lowest_frequency(ctx: &Context) -> f64 {
+    2.0 / (ctx.times[ctx.n - 1] - ctx.times[0])
+}
+
 /// The searched frequencies and their spacing.
 fn frequency_grid(ctx: &Context) -> (Vec<f64>, f64, f64) {
     let span = ctx.times[ctx.n - 1] - ctx.times[0];
     let dt = span / (ctx.n - 1).max(1) as f64;
     let nyquist = 0.5 / dt;
-    // Below two periods over the record an oscillation is a trend (the polynomial's).
-    let f_min = 2.0 / span;
+    let f_min = lowest_frequency(ctx);
     let step = (1.0 / (OVERSAMPLING * span)).max((nyquist - f_min) / MAX_FREQUENCIES as f64);
     let grid = (0..)
         .map(|k| f_min + k as f64 * step)
