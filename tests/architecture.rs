@@ -155,7 +155,8 @@ fn every_module_of_lib_rs_is_placed_and_in_the_documented_order() {
 #[test]
 fn the_check_catches_an_import_back_up() {
     // A sampler that imported the discovery would run against the flow.
-    let dir = std::env::temp_dir().join(format!("motorcal-arch-{}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("motorcal-arch-{}", std::process::id()));
     std::fs::create_dir_all(dir.join("sampler")).unwrap();
     std::fs::write(
         dir.join("sampler/bad.rs"),

@@ -262,7 +262,8 @@ fn sensitivities_hold_across_the_delay_s_ramps_and_at_the_coupling_s_absent_shar
 
 #[test]
 fn a_sensor_lag_names_its_channel_and_a_bad_one_is_one_error() {
-    let dir = std::env::temp_dir().join(format!("motorcal-lag-{}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("motorcal-lag-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("model.toml");
     let read = |text: &str| {

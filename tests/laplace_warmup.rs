@@ -59,7 +59,8 @@ fn a_fit_without_warmup_runs_the_short_default_and_keeps_the_laplace_metric() {
         stan
     );
 
-    let dir = std::env::temp_dir().join(format!("motorcal-default-warmup-{}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("motorcal-default-warmup-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     let path = |name: &str| dir.join(name).to_str().unwrap().to_owned();
@@ -136,7 +137,8 @@ fn warmup_on_the_laplace_metric_tunes_the_step_size_alone() {
         MetricKind::Dense,
     )
     .unwrap();
-    let dir = std::env::temp_dir().join(format!("motorcal-laplace-{}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("motorcal-laplace-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     for metric_adaptation in [MetricAdaptation::Laplace, MetricAdaptation::Windows] {
         let saved = dir.join(format!("{}.toml", metric_adaptation.name()));

@@ -193,7 +193,8 @@ fn the_real_records_are_plausible() {
 /// fit.json.
 #[test]
 fn diagnose_refuses_a_dead_recording_unless_forced() {
-    let dir = std::env::temp_dir().join(format!("motorcal-plaus-{}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("motorcal-plaus-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let case = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/cases/torque_constant");
     let text = std::fs::read_to_string(case.join("recording.csv")).unwrap();

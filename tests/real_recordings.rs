@@ -33,7 +33,8 @@ fn example(name: &str) -> PathBuf {
 fn window(source: &Path, rows: usize, name: &str) -> PathBuf {
     let text = std::fs::read_to_string(source).unwrap();
     let head: Vec<&str> = text.lines().take(rows + 1).collect();
-    let dir = std::env::temp_dir().join(format!("motorcal-real-{}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("motorcal-real-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join(name);
     std::fs::write(&path, head.join("\n") + "\n").unwrap();
@@ -41,7 +42,8 @@ fn window(source: &Path, rows: usize, name: &str) -> PathBuf {
 }
 
 fn scratch_file(name: &str, text: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("motorcal-real-{}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("motorcal-real-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join(name);
     std::fs::write(&path, text).unwrap();
@@ -255,7 +257,8 @@ fn the_measured_current_drives_hsm150_as_its_readme_found() {
 /// One line on stderr naming the file and field, a non-zero exit, nothing written.
 fn refuses(model_text: &str, data: &Path, expected: &str) {
     let model = scratch_file("bad-drive.toml", model_text);
-    let json = std::env::temp_dir().join("motorcal-real-never-written.json");
+    let json =
+        std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("motorcal-real-never-written.json");
     let out = Command::new(env!("CARGO_BIN_EXE_motorcal"))
         .args(["predict", "--model"])
         .arg(&model)

@@ -25,7 +25,8 @@ fn options(ks: Vec<usize>, out: &str) -> SweepOptions {
             quiet: true,
             ..RunSettings::default()
         },
-        out: std::env::temp_dir().join(format!("motorcal-sweep-{}-{out}", std::process::id())),
+        out: std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+            .join(format!("motorcal-sweep-{}-{out}", std::process::id())),
         json: None,
         figures_at: Vec::new(),
     }

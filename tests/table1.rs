@@ -4,7 +4,8 @@ use motorcal::paper::table1::{Table1Options, Table1Report, Table1Row, reproduce_
 use motorcal::pipeline::SamplerKind;
 
 fn run(quick: bool, samplers: Vec<SamplerKind>, name: &str) -> Table1Report {
-    let out = std::env::temp_dir().join(format!("motorcal-table1-{}-{name}", std::process::id()));
+    let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("motorcal-table1-{}-{name}", std::process::id()));
     let options = Table1Options {
         quick,
         samplers,
