@@ -153,6 +153,7 @@ fn main() {
             input,
             seed,
             conceal: true,
+            tied: false,
         });
         (name, case)
     };

@@ -16,6 +16,7 @@ fn main() -> Result<(), motorcal::error::Error> {
         input: InputProfile::Constant,
         seed: 2026,
         conceal: false,
+        tied: false,
     })?;
     let problem = Problem {
         label: "simulated in memory".into(),

@@ -78,6 +78,7 @@ fn main() {
                 input: *input,
                 seed: *seed,
                 conceal: true,
+                tied: false,
             }) {
                 Ok(c) => c,
                 Err(e) => {

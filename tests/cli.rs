@@ -12,7 +12,8 @@ fn motorcal(args: &[&str]) -> Output {
 }
 
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("motorcal-cli-{}-{name}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("motorcal-cli-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     dir
@@ -409,6 +410,36 @@ fn simulate_effect_makes_a_concealed_fair_case() {
     }
 }
 
+/// `--tied` keeps the input asked and redraws until the truth ties with its look-alike: a
+/// concealed Coulomb friction on a constant input (which never reverses) is a constant torque
+/// the oracle cannot tell from a load torque, yet stands out from no effect.
+#[test]
+fn simulate_tied_makes_a_concealed_tie_on_the_input_asked() {
+    let dir = scratch("tied");
+    let o = motorcal(&[
+        "simulate",
+        "--effect",
+        "coulomb_friction",
+        "--conceal",
+        "--tied",
+        "--input",
+        "constant",
+        "--seed",
+        "2",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let answer: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("answer.json")).unwrap()).unwrap();
+    assert_eq!(answer["input"], "constant");
+    assert_eq!(answer["input_fallback"], false);
+    assert_eq!(answer["oracle_runner_up"], "load_torque");
+    assert!(answer["oracle_margin"].as_f64().unwrap() < 3.0);
+    assert!(answer["oracle_margin_over_none"].as_f64().unwrap() >= 5.0);
+    assert!(String::from_utf8_lossy(&o.stdout).contains("tied with load_torque"));
+}
+
 #[test]
 fn simulate_effect_refuses_what_it_cannot_make() {
     let dir = scratch("effect-bad");
@@ -435,6 +466,11 @@ fn simulate_effect_refuses_what_it_cannot_make() {
             "--conceal",
         ]),
         &["--magnitude 2", "1.5"],
+    );
+    // A tie is a concealed effect's: --tied alone is refused.
+    assert_clean_failure(
+        &run(&["--effect", "coulomb_friction", "--tied"]),
+        &["--tied", "--conceal"],
     );
     assert!(!out.exists());
 }

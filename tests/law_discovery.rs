@@ -140,6 +140,7 @@ fn a_library_effect_is_named_by_the_library_not_rewritten_as_a_law() {
             input: InputProfile::Reversal,
             seed,
             conceal: true,
+            tied: false,
         })
         .unwrap();
         let problem = Problem {
@@ -165,6 +166,7 @@ fn a_recording_of_the_model_itself_discovers_no_law() {
             input,
             seed,
             conceal: true,
+            tied: false,
         })
         .unwrap();
         let problem = Problem {

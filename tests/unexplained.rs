@@ -133,6 +133,7 @@ fn a_recording_of_the_model_itself_leaves_nothing_unexplained() {
             input,
             seed,
             conceal: true,
+            tied: false,
         })
         .unwrap();
         let problem = Problem {

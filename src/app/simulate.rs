@@ -90,6 +90,11 @@ pub struct SimulateOptions {
     /// With --effect: keep the effect below 1.5σ and redraw until it is identifiable.
     #[arg(long, requires = "effect")]
     pub conceal: bool,
+    /// With --conceal: a tie instead — the effect stands out from no effect but not from its
+    /// look-alike (the runner-up) on the input asked, which is kept: a case to practise
+    /// `motorcal design` on. The answer names the runner-up.
+    #[arg(long)]
+    pub tied: bool,
 }
 
 impl Default for SimulateOptions {
@@ -106,6 +111,7 @@ impl Default for SimulateOptions {
             effect: None,
             magnitude: None,
             conceal: false,
+            tied: false,
         }
     }
 }
@@ -114,6 +120,11 @@ impl Default for SimulateOptions {
 /// concealed-physics case; says what it wrote.
 pub fn run(options: &SimulateOptions) -> Result<(), AppError> {
     let out = &options.out;
+    if options.tied && !options.conceal {
+        return Err(AppError::Usage(
+            "--tied needs --effect and --conceal: a tie is a concealed effect's".into(),
+        ));
+    }
     if let Some(effects) = &options.effect {
         let InputSource::Profile(input) = options.input else {
             return Err(AppError::Usage(
@@ -129,9 +140,15 @@ pub fn run(options: &SimulateOptions) -> Result<(), AppError> {
                 input,
                 seed: options.seed,
                 conceal: options.conceal,
+                tied: options.tied,
             },
             out,
         )?;
+        if let (true, Some(rival), Some(lead)) =
+            (options.tied, &answer.oracle_runner_up, answer.oracle_margin)
+        {
+            println!("tied with {rival} (the truth leads it by {lead:.2} nats)");
+        }
         println!(
             "wrote {} (effect {}, peak {:.2}/{:.2} σ on I/ω, input {:?}{})",
             out.display(),

@@ -34,6 +34,7 @@
 //!     input: InputProfile::Constant,
 //!     seed: 2026,
 //!     conceal: false,
+//!     tied: false,
 //! })?;
 //! let problem = Problem {
 //!     label: "in memory".into(),

@@ -34,6 +34,8 @@ pub const DURATION: f64 = 0.5;
 pub const CONCEALED_MAX: f64 = 1.5;
 /// Draws per input before a richer input is tried.
 pub const REDRAWS: usize = 5;
+/// Draws on the one input a tied case keeps.
+pub const TIED_REDRAWS: usize = 20;
 
 #[derive(Clone, Debug)]
 pub struct CaseOptions {
@@ -44,6 +46,11 @@ pub struct CaseOptions {
     pub input: InputProfile,
     pub seed: u64,
     pub conceal: bool,
+    /// With `conceal`: a case the oracle cannot tell from its runner-up on the input asked — a
+    /// tie, the case `motorcal design` is for. The input is kept (never fallen back from) and a
+    /// draw is redrawn until it ties (lead over the runner-up below [`RUNNER_UP_MARGIN`]) while
+    /// still standing out from no effect at all (by [`NONE_MARGIN`]).
+    pub tied: bool,
 }
 
 /// A concealed-physics case: the noisy recording, the nominal model a user would believe (the
@@ -341,15 +348,30 @@ pub fn make_case(options: &CaseOptions) -> Result<Case, Error> {
             format!("a concealed effect stays below {CONCEALED_MAX} σ"),
         ));
     }
+    if options.tied && !(options.conceal && !effects.is_empty()) {
+        return Err(Error::setting(
+            "tied",
+            "true",
+            "a tied case is a concealed effect: needs conceal and an effect",
+        ));
+    }
     let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
     let times = sample_times(DURATION, SAMPLES);
     let ladder = InputProfile::ALL;
     let first = ladder.iter().position(|i| *i == options.input).unwrap_or(0);
+    // A tie is a property of the input asked: another input would be another case.
+    let last = if options.tied {
+        first + 1
+    } else {
+        ladder.len()
+    };
     let mut attempts = 0;
-    for (rung, &input) in ladder.iter().enumerate().skip(first) {
+    for (rung, &input) in ladder.iter().enumerate().take(last).skip(first) {
         let voltage = input.voltage(24.0, &times);
         let base = nominal_problem(&voltage, &times);
-        let tries = if options.conceal && !effects.is_empty() {
+        let tries = if options.tied {
+            TIED_REDRAWS
+        } else if options.conceal && !effects.is_empty() {
             REDRAWS
         } else {
             1
@@ -399,6 +421,7 @@ pub fn make_case(options: &CaseOptions) -> Result<Case, Error> {
                 (Some(a), Some(b), Some(c))
             };
             let fair = match (margin, over_none) {
+                (Some(a), Some(c)) if options.tied => a < RUNNER_UP_MARGIN && c >= NONE_MARGIN,
                 (Some(a), Some(c)) => a >= RUNNER_UP_MARGIN && c >= NONE_MARGIN,
                 _ => true,
             };
@@ -424,11 +447,17 @@ pub fn make_case(options: &CaseOptions) -> Result<Case, Error> {
             ));
         }
     }
-    Err(Error::setting(
-        "effect",
-        options.effects.join(","),
-        format!("not identifiable on any input after {attempts} draws"),
-    ))
+    let why = if options.tied {
+        format!(
+            "no tie on the {} input after {attempts} draws (the effect either stood out from \
+             its runner-up by {RUNNER_UP_MARGIN} nats or from no effect by less than \
+             {NONE_MARGIN})",
+            options.input.name()
+        )
+    } else {
+        format!("not identifiable on any input after {attempts} draws")
+    };
+    Err(Error::setting("effect", options.effects.join(","), why))
 }
 
 /// The recording with its noise drawn, and the answer.
