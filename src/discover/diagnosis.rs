@@ -187,7 +187,7 @@ pub fn assemble(
     ranking: Vec<Candidate>,
     selection: Selection,
     as_given: AsGiven,
-    not_offered: Option<String>,
+    not_ranked: Vec<String>,
     started: Instant,
     [ranking_s, selection_s]: [f64; 2],
     progress: &impl Fn(Progress),
@@ -272,7 +272,7 @@ pub fn assemble(
         .first()
         .cloned()
         .unwrap_or_else(|| "none".into());
-    let mut notes: Vec<String> = not_offered.into_iter().collect();
+    let mut notes: Vec<String> = not_ranked;
     let mut ties = Vec::new();
     let mut tie_experiments = BTreeMap::new();
     // A discovered law has no rival in the library to be tied with: the ties are the

@@ -82,7 +82,7 @@ pub use unexplained::{Fingerprint, Span, Unexplained, UnexplainedFigure};
 use crate::bayes::ModelSettings;
 use crate::error::Error;
 use crate::study::Problem;
-use unexplained::{AsGiven, dynamic_starts, offered};
+use unexplained::{AsGiven, dynamic_starts};
 
 /// The stages of a diagnosis, as [`discover_with`] reports them to its caller.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -136,12 +136,11 @@ pub fn discover_with(
         candidates: candidates.len(),
     });
     // The model as given and the verdict on its residual come first: they say where the
-    // dynamic terms start and whether a coupling has a resonance to be ranked on.
+    // dynamic terms start.
     let none = fit_candidate(problem, &[])?;
     let as_given = AsGiven::of(problem, &none)?;
-    let (candidates, not_offered) = offered(candidates, settings.candidates.is_some(), &as_given);
     let starts = dynamic_starts(&as_given, &candidates);
-    let ranking = rank(problem, none, &candidates, &starts)?;
+    let (ranking, not_ranked) = rank(problem, none, &candidates, &starts)?;
     let ranking_s = started.elapsed().as_secs_f64();
     progress(Progress::Selecting);
     let selection = forward_selection(problem, &ranking, &candidates, &starts)?;
@@ -155,7 +154,7 @@ pub fn discover_with(
         ranking,
         selection,
         as_given,
-        not_offered,
+        not_ranked,
         started,
         [ranking_s, selection_s],
         &progress,

@@ -45,26 +45,6 @@ impl AsGiven {
         })
     }
 
-    /// The best score of a ringing oscillation of at least two periods over the record (nats,
-    /// its grid paid for): a resonance to be seen. `None` where there is none, or where the
-    /// verdict was not asked.
-    pub fn ringing_evidence(&self) -> Option<f64> {
-        self.scores
-            .as_ref()?
-            .fingerprints
-            .iter()
-            .filter(|e| match e.fingerprint {
-                Fingerprint::Oscillation {
-                    ringing: true,
-                    frequency_hz,
-                    ..
-                } => frequency_hz >= self.lowest_frequency,
-                _ => false,
-            })
-            .map(|e| e.fingerprint.score())
-            .max_by(f64::total_cmp)
-    }
-
     /// Below this frequency (Hz) an oscillation on the record is a trend.
     pub fn lowest_frequency(&self) -> f64 {
         self.lowest_frequency

@@ -49,7 +49,7 @@ pub use as_given::AsGiven;
 pub use fingerprint::{EquationTerm, Fingerprint, equation_with};
 use oscillation::Oscillation;
 use regression::{Explained, Projector, explain};
-pub use starts::{DYNAMIC, dynamic_starts, offered};
+pub use starts::{DYNAMIC, dynamic_starts};
 pub use step_screen::StepScreen;
 use timing::FinePrediction;
 

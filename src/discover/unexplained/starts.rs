@@ -4,21 +4,11 @@
 //! from the terms' defaults (τ = 0 on its bound, a resonance at 100 Hz) cannot find by itself:
 //! the likelihood in a frequency has a valley per harmonic, and at τ = 0 the gradient of a lag
 //! on one channel is no guide to which channel.
-//!
-//! And whether the compliant coupling is ranked at all: only where that residual rings after
-//! the input's steps by more than the threshold. A coupling's three parameters (the load's
-//! share, f_r, ζ) make it the library's most flexible term: with f_r far below or above what
-//! the record resolves it is a slow, state-dependent torque that absorbs part of any effect,
-//! and on two-effect records it led the ranking by tens of nats with no resonance to be seen
-//! (torque constant with quadratic drag: a "coupling" at 0.9 Hz; a voltage drop with a load
-//! step: one the backward step later dropped). A resonance is what the term is; a record that
-//! shows none gives no evidence for it that a generic alternative would not take.
 
 use crate::motor::Term;
 use crate::parameter::ParamId;
 
 use super::super::candidate::Starts;
-use super::super::settings::EVIDENCE_THRESHOLD;
 use super::{AsGiven, Fingerprint};
 
 /// The dynamic terms the starts are for.
@@ -83,38 +73,4 @@ pub fn dynamic_starts(as_given: &AsGiven, candidates: &[String]) -> Starts {
         );
     }
     starts
-}
-
-/// The candidates to rank: `candidates` less the compliant coupling where the model as given's
-/// residual does not ring by more than the threshold (see the module's note), unless the user
-/// named it (`asked`). Returns the note saying so where it was left out.
-pub fn offered(
-    candidates: Vec<String>,
-    asked: bool,
-    as_given: &AsGiven,
-) -> (Vec<String>, Option<String>) {
-    const COUPLING: &str = "compliant_coupling";
-    if asked || !candidates.iter().any(|c| c == COUPLING) {
-        return (candidates, None);
-    }
-    let evidence = as_given.ringing_evidence().unwrap_or(f64::NEG_INFINITY);
-    if evidence > EVIDENCE_THRESHOLD {
-        return (candidates, None);
-    }
-    let shown = if evidence.is_finite() {
-        format!("{evidence:.1} nats")
-    } else {
-        "none".to_string()
-    };
-    let note = format!(
-        "{COUPLING} was not ranked: the residual of the model as given does not ring after the \
-         input's steps, two periods or more over the record (evidence {shown}, threshold \
-         {EVIDENCE_THRESHOLD} nats), and a coupling \
-         without a resonance to show is a slow torque any effect can hide in; name it with \
-         --candidates to rank it anyway"
-    );
-    (
-        candidates.into_iter().filter(|c| c != COUPLING).collect(),
-        Some(note),
-    )
 }
