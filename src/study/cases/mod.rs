@@ -348,7 +348,7 @@ pub fn make_case(options: &CaseOptions) -> Result<Case, Error> {
             format!("a concealed effect stays below {CONCEALED_MAX} σ"),
         ));
     }
-    if options.tied && !(options.conceal && !effects.is_empty()) {
+    if options.tied && (!options.conceal || effects.is_empty()) {
         return Err(Error::setting(
             "tied",
             "true",
