@@ -52,10 +52,10 @@ pub fn named_term(problem: &Problem, fingerprint: &Fingerprint) -> Option<NamedT
             frequency_hz,
             damping_ratio,
             ringing: true,
-            grid_points,
+            frequencies,
             ..
         } => {
-            search_penalty = (*grid_points.max(&1) as f64).ln();
+            search_penalty = (*frequencies.max(&1) as f64).ln();
             (
                 Term::named("compliant_coupling")?,
                 vec![

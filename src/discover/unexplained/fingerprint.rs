@@ -25,9 +25,11 @@ pub enum Fingerprint {
         channel: String,
         ringing: bool,
         score: f64,
-        /// The points its search ran over: a fit started at it pays ln of this.
+        /// The frequencies its search ran over: a coupling started at its frequency pays ln of
+        /// this. Not the decay times it also tried: the coupling's damping ratio is one of its
+        /// parameters, paid for by ½·ln N in its score like every other.
         #[serde(skip)]
-        grid_points: usize,
+        frequencies: usize,
     },
     Delay {
         seconds: f64,

@@ -392,7 +392,7 @@ fn oscillation_fingerprint(o: &Oscillation, channel: &str, shift: f64) -> Finger
         channel: channel.to_string(),
         ringing: o.ringing(),
         score: o.scored.score - shift,
-        grid_points: o.points,
+        frequencies: o.frequencies,
     }
 }
 

@@ -33,9 +33,10 @@ pub struct Oscillation {
     /// The decay rate λ [1/s] of a ringing oscillation (none for one that runs on).
     pub decay: Option<f64>,
     pub scored: Scored,
-    /// The points its search ran over (frequencies, and decay times for a ringing one): what
-    /// its best pays, ln of this, wherever its estimate is used.
-    pub points: usize,
+    /// The frequencies its search ran over (it pays ln of every point tried, decay times
+    /// included): what a term started at its frequency pays, ln of this — the term's damping
+    /// is a parameter its score pays for already.
+    pub frequencies: usize,
 }
 
 impl Oscillation {
@@ -282,7 +283,7 @@ pub fn search(ctx: &Context, c: usize) -> Vec<Oscillation> {
             frequency_sd,
             decay,
             scored: Scored::new(e, penalty),
-            points,
+            frequencies: grid.len(),
         });
     }
     out

@@ -50,7 +50,7 @@ pub fn dynamic_starts(as_given: &AsGiven, candidates: &[String]) -> Starts {
     if let Some(Fingerprint::Oscillation {
         frequency_hz,
         damping_ratio,
-        grid_points,
+        frequencies,
         ..
     }) = best(&|f| match f {
         Fingerprint::Oscillation {
@@ -69,7 +69,7 @@ pub fn dynamic_starts(as_given: &AsGiven, candidates: &[String]) -> Starts {
         );
         starts.search_penalty.insert(
             "compliant_coupling".into(),
-            (grid_points.max(1) as f64).ln(),
+            (frequencies.max(1) as f64).ln(),
         );
     }
     starts
