@@ -45,6 +45,13 @@ fn rank_only(dir: &Path) -> Diagnosis {
     discover(&problem, &settings).expect("discover runs")
 }
 
+/// The selected set of a rank-only diagnosis, sorted.
+fn selected_sorted(diagnosis: &Diagnosis) -> Vec<String> {
+    let mut selected = diagnosis.selected_set.clone();
+    selected.sort();
+    selected
+}
+
 fn names_the_concealed_effect(name: &str) {
     let dir = case_dir(name);
     let truth = concealed_effect(&dir);
@@ -83,9 +90,10 @@ fn discover_names_a_concealed_torque_constant_error() {
 #[test]
 fn a_term_the_later_terms_make_redundant_is_dropped() {
     let diagnosis = rank_only(&case_dir("coulomb_friction+resistance_heating"));
-    let mut selected = diagnosis.selected_set.clone();
-    selected.sort();
-    assert_eq!(selected, ["coulomb_friction", "resistance_heating"]);
+    assert_eq!(
+        selected_sorted(&diagnosis),
+        ["coulomb_friction", "resistance_heating"]
+    );
 }
 
 /// A coupling fitted with its resonance below what the record can show is not ranked. On this
@@ -111,9 +119,7 @@ fn a_coupling_whose_resonance_the_record_cannot_show_is_not_ranked() {
         "notes {:?}",
         diagnosis.notes
     );
-    let mut selected = diagnosis.selected_set.clone();
-    selected.sort();
-    assert_eq!(selected, ["load_step", "voltage_drop"]);
+    assert_eq!(selected_sorted(&diagnosis), ["load_step", "voltage_drop"]);
 }
 
 /// The same rule on a step record of a torque-constant error with quadratic drag (`--seed
@@ -131,9 +137,10 @@ fn a_slow_coupling_no_longer_stands_in_for_two_static_terms() {
         let f_r = r.params["f_r"].expect("a fitted f_r");
         assert!(f_r >= 4.0, "f_r {f_r}");
     }
-    let mut selected = diagnosis.selected_set.clone();
-    selected.sort();
-    assert_eq!(selected, ["quadratic_drag", "torque_constant"]);
+    assert_eq!(
+        selected_sorted(&diagnosis),
+        ["quadratic_drag", "torque_constant"]
+    );
 }
 
 /// A resonance a larger effect hides is found in the forward step. On this reversal record of a
@@ -145,7 +152,8 @@ fn a_slow_coupling_no_longer_stands_in_for_two_static_terms() {
 #[test]
 fn a_coupling_hidden_by_a_larger_effect_is_found_in_the_second_step() {
     let diagnosis = rank_only(&case_dir("back_emf_constant+compliant_coupling"));
-    let mut selected = diagnosis.selected_set.clone();
-    selected.sort();
-    assert_eq!(selected, ["back_emf_constant", "compliant_coupling"]);
+    assert_eq!(
+        selected_sorted(&diagnosis),
+        ["back_emf_constant", "compliant_coupling"]
+    );
 }

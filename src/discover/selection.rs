@@ -12,7 +12,7 @@ use super::candidate::{Candidate, Starts, fit_candidate_started};
 use super::confirm::importance_evidence;
 use super::settings::{EVIDENCE_THRESHOLD, MAX_TERMS, uses_laplace};
 use super::state::records_reverse;
-use super::unexplained::{DYNAMIC, StepScreen};
+use super::unexplained::{DYNAMIC, StepScreen, lowest_frequency_over};
 
 /// Ranks `candidates` one at a time against `none` (the model as given at its MAP), best
 /// first. Fits are deterministic and independent, so they run in parallel without changing a
@@ -76,7 +76,7 @@ fn lowest_resonance(problem: &Problem) -> f64 {
         .iter()
         .map(|r| r.time.last().unwrap_or(&0.0) - r.time.first().unwrap_or(&0.0))
         .fold(0.0, f64::max);
-    2.0 / span
+    lowest_frequency_over(span)
 }
 
 /// A compliant coupling fitted with its resonance below what the record can show: its f_r.

@@ -184,7 +184,12 @@ fn golden(lo: f64, hi: f64, mut g: impl FnMut(f64) -> f64) -> f64 {
 /// The lowest frequency an oscillation is told from a trend at: below two periods over the
 /// record it is one (the polynomial's).
 pub fn lowest_frequency(ctx: &Context) -> f64 {
-    2.0 / (ctx.times[ctx.n - 1] - ctx.times[0])
+    lowest_frequency_over(ctx.times[ctx.n - 1] - ctx.times[0])
+}
+
+/// The same, for a record of `span` seconds: two periods over it.
+pub fn lowest_frequency_over(span: f64) -> f64 {
+    2.0 / span
 }
 
 /// The searched frequencies and their spacing.
