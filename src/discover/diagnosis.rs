@@ -287,10 +287,13 @@ pub fn assemble(
             let Some(name) = other.added.first() else {
                 continue;
             };
-            // A fit confounded with an input step is no rival: it is never selected.
-            if name == &selected
+            // A fit confounded with an input step is no rival: it is never selected. Nor is a
+            // term the selection holds, or one that alone scores well above the selected term
+            // alone: the selection (a pair that beat it, found among the ranking's leaders)
+            // has already been preferred to it.
+            if selected_set.contains(name)
                 || other.coincidence.is_some()
-                || first.score - other.score > EVIDENCE_THRESHOLD
+                || (first.score - other.score).abs() > EVIDENCE_THRESHOLD
             {
                 continue;
             }
