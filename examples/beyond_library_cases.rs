@@ -8,8 +8,9 @@
 //! noise-free truth misses the best nominal model by (R refitted by weighted least squares), in
 //! nats: ½·Σ((truth − nominal)/σ)², drawn log-uniform from [--min-nats, --max-nats].
 //!
-//! Each case folder holds `recording.csv`, `motor.toml` (the nominal model) and `answer.json`
-//! (the effect, its parameters, the fingerprint a tool should find, the miss in nats).
+//! Each case folder holds `recording.csv`, `motor.toml` (the nominal model), `answer.json`
+//! (the effect, its parameters, the fingerprint a tool should find, the miss in nats) and
+//! `truth.csv` (the recording without its noise).
 //!
 //! cargo run --release --example beyond_library_cases -- [--out DIR] [--per-effect 3]
 //!     [--seed-base 510000] [--min-nats 20] [--max-nats 300] [--effects a,b,…]
@@ -457,6 +458,21 @@ fn main() {
                 csv.push('\n');
             }
             std::fs::write(dir.join("recording.csv"), csv).unwrap();
+            // The noise-free truth beside it, for asking what the library's best term leaves
+            // of the miss (examples/library_residual.rs); no draw of the generator reads it.
+            let mut clean = String::from(if type_b {
+                "t,I,omega,U\n"
+            } else {
+                "t,I,omega\n"
+            });
+            for (k, (&t, y)) in times.iter().zip(&truth).enumerate() {
+                let _ = write!(clean, "{t:?},{:?},{:?}", y[0], y[1]);
+                if let Some(u) = &input.held {
+                    let _ = write!(clean, ",{:?}", u[k]);
+                }
+                clean.push('\n');
+            }
+            std::fs::write(dir.join("truth.csv"), clean).unwrap();
             let channels = if type_b { "U = \"U\"\n" } else { "" };
             std::fs::write(
                 dir.join("motor.toml"),

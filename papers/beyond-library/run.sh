@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The beyond-library development set and the verdict on it: cases made by the independent RK4
 # generator (examples/beyond_library_cases.rs), each diagnosed rank-only by the release binary,
-# and the summary table (summarize.py). Two cases at a time on this 2-core machine.
+# and the summary table (summarize.py), then what the library's best term leaves of each miss
+# (examples/library_residual.rs). Two cases at a time on this 2-core machine.
 #   papers/beyond-library/run.sh [per-effect] [seed-base]
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
@@ -14,3 +15,6 @@ ls -d "$cases"/*/ | xargs -P 2 -I{} sh -c \
   "target/release/motorcal diagnose --quiet --rank-only --data {}recording.csv --model {}motor.toml --json {}report.json > {}report.txt 2>&1"
 python3 "$here/summarize.py" "$cases" > "$here/cases.md"
 cat "$here/cases.md"
+# What the library's best single term leaves of each noise-free miss (the stand-in criterion).
+cargo run --release --example library_residual -- "$cases"/*/ > "$here/library-residual.md"
+cat "$here/library-residual.md"
