@@ -116,7 +116,9 @@ pub struct Starts {
     /// Terms with the settings the estimates chose (the channel a lag is on).
     pub terms: Vec<Term>,
     /// Nats a term's score pays because its start was the best of a grid of G points (a
-    /// frequency): ln G, the Bonferroni bound on the best of G, as the verdict's sinusoid pays.
+    /// frequency), on top of ½·ln N per parameter: ln G − ½·ln N, so that the frequency pays
+    /// ln G (the Bonferroni bound on the best of G) in place of its ½·ln N, as the verdict's
+    /// sinusoid pays it (`unexplained::frequency_search_cost`).
     pub search_penalty: BTreeMap<String, f64>,
 }
 

@@ -23,14 +23,15 @@ use crate::study::Problem;
 
 use super::candidate::{Candidate, Starts, fit_candidate_started};
 use super::settings::EVIDENCE_THRESHOLD;
-use super::unexplained::{EquationTerm, Fingerprint, equation_with};
+use super::unexplained::{EquationTerm, Fingerprint, equation_with, frequency_search_cost};
 
 /// The term a fingerprint names, with its settings and the parameter values it starts at.
 #[derive(Clone, Debug, PartialEq)]
 pub struct NamedTerm {
     pub term: Term,
     pub start: Vec<(&'static str, f64)>,
-    /// ln of the grid its start was the best of (a frequency), paid by its score.
+    /// What its score pays for the grid its start was the best of (a frequency's ln G in
+    /// place of its ½·ln N: `unexplained::frequency_search_cost`).
     pub search_penalty: f64,
 }
 
@@ -55,7 +56,8 @@ pub fn named_term(problem: &Problem, fingerprint: &Fingerprint) -> Option<NamedT
             frequencies,
             ..
         } => {
-            search_penalty = (*frequencies.max(&1) as f64).ln();
+            search_penalty =
+                frequency_search_cost(*frequencies, (problem.n_observations().max(1) as f64).ln());
             (
                 Term::named("compliant_coupling")?,
                 vec![

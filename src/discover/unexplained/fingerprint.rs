@@ -26,8 +26,9 @@ pub enum Fingerprint {
         ringing: bool,
         score: f64,
         /// The frequencies its search ran over: a coupling started at its frequency pays ln of
-        /// this. Not the decay times it also tried: the coupling's damping ratio is one of its
-        /// parameters, paid for by ½·ln N in its score like every other.
+        /// this for f_r, in place of ½·ln N (`frequency_search_cost`). Not the decay times it
+        /// also tried: the coupling's damping ratio is one of its parameters, paid for by
+        /// ½·ln N in its score like every other.
         #[serde(skip)]
         frequencies: usize,
     },

@@ -34,8 +34,9 @@ pub struct Oscillation {
     pub decay: Option<f64>,
     pub scored: Scored,
     /// The frequencies its search ran over (it pays ln of every point tried, decay times
-    /// included): what a term started at its frequency pays, ln of this — the term's damping
-    /// is a parameter its score pays for already.
+    /// included): a term started at its frequency pays ln of this in place of its frequency's
+    /// ½·ln N (`frequency_search_cost`) — the term's damping is a parameter its score pays
+    /// for already.
     pub frequencies: usize,
 }
 
@@ -190,6 +191,18 @@ pub fn lowest_frequency(ctx: &Context) -> f64 {
 /// The same, for a record of `span` seconds: two periods over it.
 pub fn lowest_frequency_over(span: f64) -> f64 {
     2.0 / span
+}
+
+/// What a term whose frequency started at the best of a grid of `frequencies` points pays on
+/// top of its score's ½·ln N per parameter: the frequency's look-elsewhere cost, ln G, *in
+/// place of* its ½·ln N, as this search's sinusoid pays it (ln G for the frequency, ½·ln N for
+/// each coefficient). Charging both counted the frequency twice: under a prior uniform over the
+/// searched band the frequency's Occam factor is ln(band / (√(2π)·σ_f)), and with σ_f of a
+/// sinusoid gaining 15 nats on 501 samples over 0.5 s (about 0.2 Hz) that is ln 990 over the
+/// 4–500 Hz band — the grid's ln G (992 points at four per Fourier spacing), not ln G + ½·ln N.
+/// Never below zero: a grid coarser than √N points costs the frequency its ½·ln N still.
+pub fn frequency_search_cost(frequencies: usize, ln_n: f64) -> f64 {
+    ((frequencies.max(1) as f64).ln() - 0.5 * ln_n).max(0.0)
 }
 
 /// The searched frequencies and their spacing.

@@ -69,7 +69,7 @@ pub fn dynamic_starts(as_given: &AsGiven, candidates: &[String]) -> Starts {
         );
         starts.search_penalty.insert(
             "compliant_coupling".into(),
-            (frequencies.max(1) as f64).ln(),
+            as_given.frequency_search_cost(frequencies),
         );
     }
     starts
