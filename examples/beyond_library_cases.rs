@@ -276,6 +276,23 @@ fn simulate(m: &Motor, e: Option<&Effect>, input: &Input, times: &[f64]) -> Vec<
     out
 }
 
+/// A recording's CSV text: `t,I,omega` and the held voltage `U` where there is one.
+fn csv_of(times: &[f64], rows: &[[f64; 2]], held: Option<&[f64]>) -> String {
+    let mut csv = String::from(if held.is_some() {
+        "t,I,omega,U\n"
+    } else {
+        "t,I,omega\n"
+    });
+    for (k, (&t, y)) in times.iter().zip(rows).enumerate() {
+        let _ = write!(csv, "{t:?},{:?},{:?}", y[0], y[1]);
+        if let Some(u) = held {
+            let _ = write!(csv, ",{:?}", u[k]);
+        }
+        csv.push('\n');
+    }
+    csv
+}
+
 fn miss(a: &[[f64; 2]], b: &[[f64; 2]]) -> f64 {
     a.iter()
         .zip(b)
@@ -430,11 +447,6 @@ fn main() {
             let noise: [Normal<f64>; 2] = SIGMA.map(|s| Normal::new(0.0, s).unwrap());
             let dir = out.join(format!("{name}-{seed}"));
             std::fs::create_dir_all(&dir).unwrap();
-            let mut csv = String::from(if type_b {
-                "t,I,omega,U\n"
-            } else {
-                "t,I,omega\n"
-            });
             let mut peak = [0.0f64; 2];
             let nominal = simulate(
                 &Motor {
@@ -445,34 +457,20 @@ fn main() {
                 &input,
                 &times,
             );
-            for (k, (&t, y)) in times.iter().zip(&truth).enumerate() {
+            let mut noisy = Vec::with_capacity(truth.len());
+            for (k, y) in truth.iter().enumerate() {
                 let i = y[0] + noise[0].sample(&mut rng);
                 let w = y[1] + noise[1].sample(&mut rng);
                 for c in 0..2 {
                     peak[c] = peak[c].max(((y[c] - nominal[k][c]) / SIGMA[c]).abs());
                 }
-                let _ = write!(csv, "{t:?},{i:?},{w:?}");
-                if let Some(u) = &input.held {
-                    let _ = write!(csv, ",{:?}", u[k]);
-                }
-                csv.push('\n');
+                noisy.push([i, w]);
             }
-            std::fs::write(dir.join("recording.csv"), csv).unwrap();
+            let held = input.held.as_deref();
+            std::fs::write(dir.join("recording.csv"), csv_of(&times, &noisy, held)).unwrap();
             // The noise-free truth beside it, for asking what the library's best term leaves
             // of the miss (examples/library_residual.rs); no draw of the generator reads it.
-            let mut clean = String::from(if type_b {
-                "t,I,omega,U\n"
-            } else {
-                "t,I,omega\n"
-            });
-            for (k, (&t, y)) in times.iter().zip(&truth).enumerate() {
-                let _ = write!(clean, "{t:?},{:?},{:?}", y[0], y[1]);
-                if let Some(u) = &input.held {
-                    let _ = write!(clean, ",{:?}", u[k]);
-                }
-                clean.push('\n');
-            }
-            std::fs::write(dir.join("truth.csv"), clean).unwrap();
+            std::fs::write(dir.join("truth.csv"), csv_of(&times, &truth, held)).unwrap();
             let channels = if type_b { "U = \"U\"\n" } else { "" };
             std::fs::write(
                 dir.join("motor.toml"),

@@ -9,6 +9,7 @@
 
 use std::path::Path;
 
+use motorcal::error::Error;
 use motorcal::motor::Term;
 use motorcal::study::Problem;
 use motorcal::study::cases::NOISE_SD;
@@ -24,33 +25,53 @@ fn main() {
         "| case | miss of the nominal model (nats) | best library term | miss it leaves (nats) | runner-up | its miss |"
     );
     println!("|---|---|---|---|---|---|");
+    let mut failed = 0;
     for dir in dirs {
         let dir = Path::new(&dir);
-        let problem = match Problem::from_files(&[dir.join("truth.csv")], &dir.join("motor.toml")) {
-            Ok(p) => p,
+        match library_residual(dir) {
+            Ok(row) => println!("{row}"),
             Err(e) => {
                 eprintln!("{}: {e}", dir.display());
-                continue;
+                failed += 1;
             }
-        };
-        let record = &problem.recordings[0];
-        let target: Vec<f64> = ["I", "omega"]
-            .iter()
-            .flat_map(|c| record.channel(c).expect("the channel").to_vec())
-            .collect();
-        let miss = |added: &[String]| {
-            least_squares(&problem, added, &target, &NOISE_SD).map(|(ss, _)| 0.5 * ss)
-        };
-        let none = miss(&[]).unwrap_or(f64::NAN);
-        let mut fits: Vec<(String, f64)> = Term::NAMES
-            .iter()
-            .filter_map(|t| miss(&[t.to_string()]).ok().map(|m| (t.to_string(), m)))
-            .collect();
-        fits.sort_by(|a, b| a.1.total_cmp(&b.1));
-        let name = dir.file_name().unwrap().to_string_lossy();
-        println!(
-            "| {name} | {none:.1} | {} | {:.1} | {} | {:.1} |",
-            fits[0].0, fits[0].1, fits[1].0, fits[1].1
-        );
+        }
     }
+    if failed > 0 {
+        std::process::exit(1);
+    }
+}
+
+/// The table row of one case folder.
+fn library_residual(dir: &Path) -> Result<String, Error> {
+    let problem = Problem::from_files(&[dir.join("truth.csv")], &dir.join("motor.toml"))?;
+    let record = &problem.recordings[0];
+    let mut target = Vec::new();
+    for c in ["I", "omega"] {
+        let values = record.channel(c).ok_or_else(|| {
+            Error::invalid(format!(
+                "{}: no channel {c}",
+                dir.join("truth.csv").display()
+            ))
+        })?;
+        target.extend_from_slice(values);
+    }
+    let miss = |added: &[String]| {
+        least_squares(&problem, added, &target, &NOISE_SD).map(|(ss, _)| 0.5 * ss)
+    };
+    let none = miss(&[])?;
+    let mut fits: Vec<(String, f64)> = Term::NAMES
+        .iter()
+        .filter_map(|t| miss(&[t.to_string()]).ok().map(|m| (t.to_string(), m)))
+        .collect();
+    fits.sort_by(|a, b| a.1.total_cmp(&b.1));
+    let [best, runner_up, ..] = fits.as_slice() else {
+        return Err(Error::invalid(
+            "fewer than two library terms could be fitted",
+        ));
+    };
+    let name = dir.file_name().unwrap_or_default().to_string_lossy();
+    Ok(format!(
+        "| {name} | {none:.1} | {} | {:.1} | {} | {:.1} |",
+        best.0, best.1, runner_up.0, runner_up.1
+    ))
 }

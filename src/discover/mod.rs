@@ -139,7 +139,7 @@ pub fn discover_with(
     // dynamic terms start.
     let none = fit_candidate(problem, &[])?;
     let as_given = AsGiven::of(problem, &none)?;
-    let starts = dynamic_starts(&as_given, &candidates);
+    let starts = dynamic_starts(problem, &as_given, &candidates);
     let (ranking, not_ranked) = rank(problem, none, &candidates, &starts)?;
     let ranking_s = started.elapsed().as_secs_f64();
     progress(Progress::Selecting);

@@ -56,8 +56,7 @@ pub fn named_term(problem: &Problem, fingerprint: &Fingerprint) -> Option<NamedT
             frequencies,
             ..
         } => {
-            search_penalty =
-                frequency_search_cost(*frequencies, (problem.n_observations().max(1) as f64).ln());
+            search_penalty = frequency_search_cost(*frequencies, problem.n_observations());
             (
                 Term::named("compliant_coupling")?,
                 vec![

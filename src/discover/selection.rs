@@ -256,14 +256,17 @@ pub fn forward_selection(
 /// How many leaders of the ranking the second step pairs among themselves: the first step's
 /// leader and the six after it. A cap set by cost, not by a case: the second step fits the
 /// leader beside each of the other candidates (about fifteen fits); the pairs of six others add
-/// fifteen more at most, each of library terms only (a solve costs milliseconds).
+/// fifteen more at most, of library terms only. On 501 samples that is a few seconds' CPU; on
+/// EMPS's 24 841, where these pairs skip the first-order screen the step's dear fits go
+/// through, it added 3.8 s to a 52-s diagnosis (papers/diagnose-speed).
 const PAIRED_LEADERS: usize = 7;
 
-/// Pairs of ranking leaders, neither of them the first step's, with their starts. Greedy addition finds a pair only through its better half: two
-/// concealed effects whose sum a third term mimics (Coulomb and asymmetric friction together
-/// read as a load step, which led the ranking by 40 nats on one record and left no second term
-/// worth its threshold beside it, though the true pair scored 4.9 nats above it) are reached
-/// from neither. Only candidates that alone beat the model as given by more than the
+/// Pairs of ranking leaders, neither of them the first step's, with their starts. Greedy
+/// addition finds a pair only through its better half: two concealed effects whose sum a third
+/// term mimics (Coulomb and asymmetric friction together read as a load step, which led the
+/// ranking and left no second term worth its threshold beside it, though the true pair scored
+/// more than the threshold above it: `two_effects_a_third_term_mimics_are_found_as_a_pair`)
+/// are reached from neither. Only candidates that alone beat the model as given by more than the
 /// threshold are paired — each half of a pair the record holds explains part of it alone — and
 /// no dynamic term (their fits cost seconds; the step pairs them with the leader already).
 fn leader_pairs(
@@ -289,9 +292,10 @@ fn leader_pairs(
                 continue;
             }
             // The motor's own parameters start where the better half's fit ended; the terms'
-            // start as in the ranking, from several points each (started where each single
-            // fit ended, a load step's switching time stays where it had absorbed its partner:
-            // 43.1 nats against the 51.1 the pair reaches from its defaults, on one record).
+            // start as in the ranking, from several points each. Started where each single fit
+            // ended, a load step's switching time stays where it had absorbed its partner (on
+            // one record 8 nats short of the pair's fit from its defaults, by a temporary probe
+            // not kept).
             let mut s = starts.clone();
             s.values.extend(
                 a.theta

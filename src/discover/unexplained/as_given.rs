@@ -21,8 +21,6 @@ pub struct AsGiven {
     scores: Option<Scores>,
     /// Below this frequency (Hz) an oscillation on the record is a trend.
     lowest_frequency: f64,
-    /// ln N of the scores.
-    ln_n: f64,
 }
 
 impl AsGiven {
@@ -32,7 +30,6 @@ impl AsGiven {
             laws: Vec::new(),
             scores: None,
             lowest_frequency: f64::INFINITY,
-            ln_n: (problem.n_observations().max(1) as f64).ln(),
         };
         if problem.recordings.is_empty() {
             return Ok(nothing);
@@ -45,18 +42,12 @@ impl AsGiven {
             laws: state::fingerprints(none, &ctx, 0.0)?,
             scores: Some(scores(&ctx, 0.0)),
             lowest_frequency: oscillation::lowest_frequency(&ctx),
-            ln_n: ctx.ln_n,
         })
     }
 
     /// Below this frequency (Hz) an oscillation on the record is a trend.
     pub fn lowest_frequency(&self) -> f64 {
         self.lowest_frequency
-    }
-
-    /// What a term started at the best of `frequencies` searched pays for the search.
-    pub fn frequency_search_cost(&self, frequencies: usize) -> f64 {
-        oscillation::frequency_search_cost(frequencies, self.ln_n)
     }
 
     /// The laws' fingerprints.

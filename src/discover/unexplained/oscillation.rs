@@ -201,7 +201,9 @@ pub fn lowest_frequency_over(span: f64) -> f64 {
 /// sinusoid gaining 15 nats on 501 samples over 0.5 s (about 0.2 Hz) that is ln 990 over the
 /// 4–500 Hz band — the grid's ln G (992 points at four per Fourier spacing), not ln G + ½·ln N.
 /// Never below zero: a grid coarser than √N points costs the frequency its ½·ln N still.
-pub fn frequency_search_cost(frequencies: usize, ln_n: f64) -> f64 {
+/// `observations`: the N of the scores.
+pub fn frequency_search_cost(frequencies: usize, observations: usize) -> f64 {
+    let ln_n = (observations.max(1) as f64).ln();
     ((frequencies.max(1) as f64).ln() - 0.5 * ln_n).max(0.0)
 }
 

@@ -8,7 +8,10 @@
 use crate::motor::Term;
 use crate::parameter::ParamId;
 
+use crate::study::Problem;
+
 use super::super::candidate::Starts;
+use super::oscillation::frequency_search_cost;
 use super::{AsGiven, Fingerprint};
 
 /// The dynamic terms the starts are for.
@@ -16,7 +19,7 @@ pub const DYNAMIC: [&str; 3] = ["input_delay", "sensor_lag", "compliant_coupling
 
 /// Starts for the dynamic terms among `candidates`, estimated on the model as given's residual
 /// (first record); empty when there are none to start.
-pub fn dynamic_starts(as_given: &AsGiven, candidates: &[String]) -> Starts {
+pub fn dynamic_starts(problem: &Problem, as_given: &AsGiven, candidates: &[String]) -> Starts {
     let mut starts = Starts::default();
     if !candidates.iter().any(|c| DYNAMIC.contains(&c.as_str())) {
         return starts;
@@ -69,7 +72,7 @@ pub fn dynamic_starts(as_given: &AsGiven, candidates: &[String]) -> Starts {
         );
         starts.search_penalty.insert(
             "compliant_coupling".into(),
-            as_given.frequency_search_cost(frequencies),
+            frequency_search_cost(frequencies, problem.n_observations()),
         );
     }
     starts
