@@ -77,7 +77,9 @@ pub use settings::{
 };
 pub use state::{StateFingerprint, records_reverse};
 pub use ties::TIE_EXPERIMENTS;
-pub use unexplained::{Fingerprint, Span, Unexplained, UnexplainedFigure};
+pub use unexplained::{
+    Fingerprint, Span, Unexplained, UnexplainedFigure, frequency_search_cost, searched_frequencies,
+};
 
 use crate::bayes::ModelSettings;
 use crate::error::Error;

@@ -53,6 +53,7 @@ pub fn named_term(problem: &Problem, fingerprint: &Fingerprint) -> Option<NamedT
             frequency_hz,
             damping_ratio,
             ringing: true,
+            sensor: false,
             frequencies,
             ..
         } => {

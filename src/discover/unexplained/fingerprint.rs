@@ -24,6 +24,9 @@ pub enum Fingerprint {
         damping_ratio: Option<f64>,
         channel: String,
         ringing: bool,
+        /// In the sensor of `channel` (a second-order filter of the measurement, fitted from
+        /// the lag: `resonance`), not in the motor or its load.
+        sensor: bool,
         score: f64,
         /// The frequencies its search ran over: a coupling started at its frequency pays ln of
         /// this for f_r, in place of ½·ln N (`frequency_search_cost`). Not the decay times it
@@ -97,8 +100,11 @@ impl Fingerprint {
     pub(super) fn identity(&self) -> String {
         match self {
             Fingerprint::Oscillation {
-                channel, ringing, ..
-            } => format!("oscillation/{channel}/{ringing}"),
+                channel,
+                ringing,
+                sensor,
+                ..
+            } => format!("oscillation/{channel}/{ringing}/{sensor}"),
             Fingerprint::Delay { .. } => "delay".into(),
             Fingerprint::Lag { channel, .. } => format!("lag/{channel}"),
             Fingerprint::State { balance, .. } => format!("state/{balance}"),
@@ -110,6 +116,20 @@ impl Fingerprint {
     /// What a user might do about it, in a sentence.
     pub fn suggestion(&self, channels: &[String]) -> String {
         match self {
+            Fingerprint::Oscillation {
+                frequency_hz,
+                damping_ratio,
+                channel,
+                sensor: true,
+                ..
+            } => format!(
+                "the {channel} sensor rings at {frequency_hz:.1} Hz (damping ratio {:.3}) \
+                 after the input steps and the motor does not (the measured channel alone \
+                 rings, as a second-order sensor does: a compliant encoder coupling, or the \
+                 logger's filter), which the first-order sensor_lag does not hold; a second \
+                 sensor on the same shaft would confirm it",
+                damping_ratio.unwrap_or(f64::NAN)
+            ),
             Fingerprint::Oscillation {
                 frequency_hz,
                 damping_ratio,

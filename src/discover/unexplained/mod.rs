@@ -5,7 +5,8 @@
 //! white noise: a discrepancy polynomial in time per channel (degrees up to a tenth of the
 //! samples), an autoregression of the residual (p = 1, 2, 4, 8), a sinusoid through the record
 //! and a damped sinusoid ringing after each input step (`oscillation`), every channel late by
-//! τ (an input delay) and one channel filtered with time constant τ (a sensor lag). Each is
+//! τ (an input delay), one channel filtered with time constant τ (a sensor lag) and with a
+//! second-order filter that rings (a resonant sensor, `resonance`). Each is
 //! scored as the ranking scores a term: its linearised gain in log likelihood with the model's
 //! parameters refitted beside it (`regression`), less ½·ln N per degree of freedom, less the
 //! logarithm of the grid a search ran over. The same alternatives are scored on the model as
@@ -29,6 +30,7 @@ mod as_given;
 mod fingerprint;
 mod oscillation;
 mod regression;
+mod resonance;
 mod starts;
 mod state;
 mod step_screen;
@@ -48,7 +50,7 @@ use super::settings::EVIDENCE_THRESHOLD;
 pub use as_given::AsGiven;
 pub use fingerprint::{EquationTerm, Fingerprint, equation_with};
 use oscillation::Oscillation;
-pub use oscillation::{frequency_search_cost, lowest_frequency_over};
+pub use oscillation::{frequency_search_cost, lowest_frequency_over, searched_frequencies};
 use regression::{Explained, Projector, explain};
 pub use starts::{DYNAMIC, dynamic_starts};
 pub use step_screen::StepScreen;
@@ -91,6 +93,9 @@ pub struct Context {
     pub steps: Vec<f64>,
     /// The prediction on a grid ten times finer, from t = 0.
     pub fine: FinePrediction,
+    /// Where the model holds a sensor lag: its channel (index in `channels`), its τ and the
+    /// fine prediction with the lag switched off (τ = 0), what a resonant sensor replaces it on.
+    pub lagged: Option<(usize, f64, FinePrediction)>,
     pub ln_n: f64,
 }
 
@@ -133,6 +138,7 @@ impl Context {
             sigma.push(s);
         }
         let fine = FinePrediction::of(&forward, &theta, &names)?;
+        let lagged = resonance::unlagged(&forward, &theta, &names)?;
         let projector = Projector::new(j);
         let y_perp = DVector::from_column_slice(
             projector
@@ -161,6 +167,7 @@ impl Context {
             projector,
             steps,
             fine,
+            lagged,
             ln_n: (problem.n_observations() as f64).ln(),
         })
     }
@@ -339,9 +346,11 @@ fn scores(ctx: &Context, shift: f64) -> Scores {
         // A lag: y_measured ≈ ŷ − τ·dŷ/dt on this channel alone (τ > 0), then fitted exactly.
         let d = DMatrix::from_column_slice(n, 1, &ctx.derivative(c));
         let s = ctx.score(&ctx.in_channel(c, &d), 0.0);
+        let mut lag = None;
         if s.explained.coefficients[0] < 0.0
             && let Some(t) = timing::fit(ctx, &ctx.fine, Some(c), -s.explained.coefficients[0])
         {
+            lag = (t.gain > 0.5 * ctx.ln_n).then_some(t.tau);
             fingerprints.push(Evidence {
                 fingerprint: Fingerprint::Lag {
                     channel: name,
@@ -353,6 +362,8 @@ fn scores(ctx: &Context, shift: f64) -> Scores {
                 explained: t.change,
             });
         }
+        // The lag's next model: a sensor that rings.
+        fingerprints.extend(resonance::evidence(ctx, c, lag, shift));
     }
     // A delay: every channel late by the same τ.
     let mut d = DMatrix::zeros(ctx.m(), 1);
@@ -392,6 +403,7 @@ fn oscillation_fingerprint(o: &Oscillation, channel: &str, shift: f64) -> Finger
         damping_ratio: o.damping_ratio(),
         channel: channel.to_string(),
         ringing: o.ringing(),
+        sensor: false,
         score: o.scored.score - shift,
         frequencies: o.frequencies,
     }

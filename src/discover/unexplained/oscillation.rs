@@ -209,10 +209,21 @@ pub fn frequency_search_cost(frequencies: usize, observations: usize) -> f64 {
 
 /// The searched frequencies and their spacing.
 fn frequency_grid(ctx: &Context) -> (Vec<f64>, f64, f64) {
-    let span = ctx.times[ctx.n - 1] - ctx.times[0];
-    let dt = span / (ctx.n - 1).max(1) as f64;
+    grid_over(ctx.times[ctx.n - 1] - ctx.times[0], ctx.n)
+}
+
+/// How many frequencies the search runs over on a record of `n` samples spanning `span`
+/// seconds: the G whose logarithm a frequency started from it pays (`frequency_search_cost`).
+pub fn searched_frequencies(span: f64, n: usize) -> usize {
+    grid_over(span, n).0.len()
+}
+
+/// The frequency grid of a record of `n` samples over `span` seconds, its spacing and its
+/// lowest frequency.
+fn grid_over(span: f64, n: usize) -> (Vec<f64>, f64, f64) {
+    let dt = span / (n - 1).max(1) as f64;
     let nyquist = 0.5 / dt;
-    let f_min = lowest_frequency(ctx);
+    let f_min = lowest_frequency_over(span);
     let step = (1.0 / (OVERSAMPLING * span)).max((nyquist - f_min) / MAX_FREQUENCIES as f64);
     let grid = (0..)
         .map(|k| f_min + k as f64 * step)

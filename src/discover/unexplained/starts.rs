@@ -58,6 +58,7 @@ pub fn dynamic_starts(problem: &Problem, as_given: &AsGiven, candidates: &[Strin
     }) = best(&|f| match f {
         Fingerprint::Oscillation {
             ringing: true,
+            sensor: false,
             frequency_hz,
             ..
         } => *frequency_hz >= as_given.lowest_frequency(),

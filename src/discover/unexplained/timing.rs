@@ -52,7 +52,11 @@ impl FinePrediction {
     }
 
     fn at(&self, c: usize, t: f64) -> f64 {
-        let y = &self.channels[c];
+        self.read(&self.channels[c], t)
+    }
+
+    /// `y`, a series on the fine grid, at time t (linear between grid points).
+    fn read(&self, y: &[f64], t: f64) -> f64 {
         let h = self.times[1] - self.times[0];
         let u = (t / h).clamp(0.0, (y.len() - 1) as f64);
         let k = (u.floor() as usize).min(y.len() - 2);
@@ -86,24 +90,31 @@ fn change(ctx: &Context, fine: &FinePrediction, channel: Option<usize>, tau: f64
                     d[(c * n + i, 0)] = (fine.at(c, t - tau) - fine.at(c, t)) / ctx.sigma[c];
                 }
             }
-            Some(l) if l == c => {
-                let x = fine.filtered(c, tau);
-                let filtered = FinePrediction {
-                    times: fine.times.clone(),
-                    channels: vec![x],
-                };
-                for (i, &t) in ctx.times.iter().enumerate() {
-                    d[(c * n + i, 0)] = (filtered.at(0, t) - fine.at(c, t)) / ctx.sigma[c];
-                }
-            }
+            Some(l) if l == c => return in_channel_change(ctx, fine, c, &fine.filtered(c, tau)),
             Some(_) => {}
         }
     }
     d
 }
 
+/// What replacing channel `c`'s fine prediction by `x` (the channel through a sensor's filter,
+/// `x` on the same fine grid) changes in the stacked whitened output.
+pub(super) fn in_channel_change(
+    ctx: &Context,
+    fine: &FinePrediction,
+    c: usize,
+    x: &[f64],
+) -> DMatrix<f64> {
+    let n = ctx.n;
+    let mut d = DMatrix::zeros(ctx.m(), 1);
+    for (i, &t) in ctx.times.iter().enumerate() {
+        d[(c * n + i, 0)] = (fine.read(x, t) - fine.at(c, t)) / ctx.sigma[c];
+    }
+    d
+}
+
 /// ½(‖y⊥‖² − ‖y⊥ − d⊥‖²): the gain of the hypothesis at this τ, its size fixed by τ itself.
-fn gain(ctx: &Context, d: &DMatrix<f64>) -> f64 {
+pub(super) fn gain(ctx: &Context, d: &DMatrix<f64>) -> f64 {
     let d_perp = ctx.projector.residualize(d);
     let mut g = 0.0;
     for i in 0..ctx.m() {
