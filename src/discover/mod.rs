@@ -77,9 +77,7 @@ pub use settings::{
 };
 pub use state::{StateFingerprint, records_reverse};
 pub use ties::TIE_EXPERIMENTS;
-pub use unexplained::{
-    Fingerprint, Span, Unexplained, UnexplainedFigure, frequency_search_cost, searched_frequencies,
-};
+pub use unexplained::{Fingerprint, Span, Unexplained, UnexplainedFigure};
 
 use crate::bayes::ModelSettings;
 use crate::error::Error;

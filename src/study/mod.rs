@@ -5,6 +5,7 @@
 //! this motor at all (`plausibility`).
 
 pub mod cases;
+pub mod frequency_grid;
 mod inputs;
 pub mod plausibility;
 mod predict;

@@ -50,7 +50,7 @@ use super::settings::EVIDENCE_THRESHOLD;
 pub use as_given::AsGiven;
 pub use fingerprint::{EquationTerm, Fingerprint, equation_with};
 use oscillation::Oscillation;
-pub use oscillation::{frequency_search_cost, lowest_frequency_over, searched_frequencies};
+pub use oscillation::{frequency_search_cost, lowest_frequency_over};
 use regression::{Explained, Projector, explain};
 pub use starts::{DYNAMIC, dynamic_starts};
 pub use step_screen::StepScreen;

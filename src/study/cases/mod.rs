@@ -16,7 +16,6 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 use serde::Serialize;
 
-use crate::discover::{frequency_search_cost, searched_frequencies};
 use crate::error::Error;
 use crate::io::{ModelFile, Recording};
 use crate::motor::{MotorParam, Term, VoltageInput};
@@ -24,6 +23,7 @@ use crate::ode::SolverSettings;
 use crate::parameter::{ParamId, Support};
 use crate::study::InputProfile;
 use crate::study::Problem;
+use crate::study::frequency_grid::{frequency_search_cost, searched_frequencies};
 use crate::synthetic::sample_times;
 
 use oracle::{NONE_MARGIN, RUNNER_UP_MARGIN, least_squares, least_squares_set};
