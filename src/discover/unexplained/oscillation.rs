@@ -12,7 +12,7 @@ use rayon::prelude::*;
 
 #[cfg(test)]
 use super::regression::gain;
-use super::regression::{explain, gain_from_normal_equations};
+use super::regression::{explain, gain_from_normal_equations, golden_max};
 use super::{Context, Scored};
 use crate::study::frequency_grid::grid_over;
 pub use crate::study::frequency_grid::{frequency_search_cost, lowest_frequency_over};
@@ -158,25 +158,8 @@ fn windowed_gain(times: &[f64], steps: &[f64], y: &[f64], f: f64, decay: Option<
     gain_from_normal_equations(&h, g)
 }
 
-fn golden(lo: f64, hi: f64, mut g: impl FnMut(f64) -> f64) -> f64 {
-    let r = (5f64.sqrt() - 1.0) / 2.0;
-    let (mut a, mut b) = (lo, hi);
-    let (mut x1, mut x2) = (b - r * (b - a), a + r * (b - a));
-    let (mut g1, mut g2) = (g(x1), g(x2));
-    for _ in 0..REFINE_STEPS {
-        if g1 > g2 {
-            b = x2;
-            (x2, g2) = (x1, g1);
-            x1 = b - r * (b - a);
-            g1 = g(x1);
-        } else {
-            a = x1;
-            (x1, g1) = (x2, g2);
-            x2 = a + r * (b - a);
-            g2 = g(x2);
-        }
-    }
-    (a + b) / 2.0
+fn golden(lo: f64, hi: f64, g: impl FnMut(f64) -> f64) -> f64 {
+    golden_max(lo, hi, REFINE_STEPS, g)
 }
 
 /// The lowest frequency an oscillation is told from a trend at: below two periods over the

@@ -111,6 +111,29 @@ pub fn explain(y: &DVector<f64>, b_tilde: &DMatrix<f64>) -> Explained {
     }
 }
 
+/// The maximiser of `g` on [lo, hi] by `steps` golden-section steps (g unimodal there): the
+/// one-dimensional search every fitted frequency, decay, delay and sensor time constant uses.
+pub fn golden_max(lo: f64, hi: f64, steps: usize, mut g: impl FnMut(f64) -> f64) -> f64 {
+    let r = (5f64.sqrt() - 1.0) / 2.0;
+    let (mut a, mut b) = (lo, hi);
+    let (mut x1, mut x2) = (b - r * (b - a), a + r * (b - a));
+    let (mut g1, mut g2) = (g(x1), g(x2));
+    for _ in 0..steps {
+        if g1 > g2 {
+            b = x2;
+            (x2, g2) = (x1, g1);
+            x1 = b - r * (b - a);
+            g1 = g(x1);
+        } else {
+            a = x1;
+            (x1, g1) = (x2, g2);
+            x2 = a + r * (b - a);
+            g2 = g(x2);
+        }
+    }
+    (a + b) / 2.0
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -15,6 +15,7 @@
 //! is that lag at low frequencies (a lightly damped one whose lag is too small to pay rings
 //! after the steps, and the damped sinusoid of `oscillation` is there for it). Two parameters, each paid ½·ln N like every other.
 
+use super::regression::golden_max;
 use super::timing::{FinePrediction, gain, in_channel_change};
 use super::{Context, Evidence, Fingerprint};
 use crate::error::Error;
@@ -66,25 +67,9 @@ fn filtered(fine: &FinePrediction, c: usize, omega_n: f64, zeta: f64) -> Vec<f64
     out
 }
 
-fn golden(lo: f64, hi: f64, iterations: usize, f: impl Fn(f64) -> f64) -> (f64, f64) {
-    let r = (5f64.sqrt() - 1.0) / 2.0;
-    let (mut a, mut b) = (lo, hi);
-    let (mut x1, mut x2) = (b - r * (b - a), a + r * (b - a));
-    let (mut f1, mut f2) = (f(x1), f(x2));
-    for _ in 0..iterations {
-        if f1 > f2 {
-            b = x2;
-            (x2, f2) = (x1, f1);
-            x1 = b - r * (b - a);
-            f1 = f(x1);
-        } else {
-            a = x1;
-            (x1, f1) = (x2, f2);
-            x2 = a + r * (b - a);
-            f2 = f(x2);
-        }
-    }
-    let x = (a + b) / 2.0;
+/// The maximiser of `f` on [lo, hi] and its value there.
+fn golden(lo: f64, hi: f64, steps: usize, f: impl Fn(f64) -> f64) -> (f64, f64) {
+    let x = golden_max(lo, hi, steps, &f);
     (x, f(x))
 }
 

@@ -15,6 +15,7 @@ use crate::error::Error;
 use crate::forward::ForwardModel;
 
 use super::Context;
+use super::regression::golden_max;
 
 /// Fine-grid points per sample interval.
 pub const FINE: usize = 10;
@@ -145,24 +146,7 @@ pub fn fit(
     let dt = ctx.times[ctx.n - 1] / ctx.n as f64;
     let hi = 4.0 * start.max(dt / FINE as f64);
     let g = |tau: f64| gain(ctx, &change(ctx, fine, channel, tau));
-    let r = (5f64.sqrt() - 1.0) / 2.0;
-    let (mut a, mut b) = (0.0, hi);
-    let (mut x1, mut x2) = (b - r * (b - a), a + r * (b - a));
-    let (mut g1, mut g2) = (g(x1), g(x2));
-    for _ in 0..30 {
-        if g1 > g2 {
-            b = x2;
-            (x2, g2) = (x1, g1);
-            x1 = b - r * (b - a);
-            g1 = g(x1);
-        } else {
-            a = x1;
-            (x1, g1) = (x2, g2);
-            x2 = a + r * (b - a);
-            g2 = g(x2);
-        }
-    }
-    let tau = (a + b) / 2.0;
+    let tau = golden_max(0.0, hi, 30, g);
     let best = g(tau);
     let h = (tau * 0.01).max(1e-9);
     let curvature = (g(tau + h) - 2.0 * best + g((tau - h).max(0.0))) / (h * h);
