@@ -163,6 +163,28 @@ fn scratch(tag: &str) -> std::path::PathBuf {
     dir.join("model.toml")
 }
 
+/// The angle's harmonic is a setting of the law, `k` in its table, written and read back.
+#[test]
+fn a_law_in_the_angle_keeps_its_harmonic() {
+    let path = scratch("harmonic");
+    let text = "schema = 2\n\n[terms.law]\n\"torque:sin(k*theta)\" = 0.01\n\
+                \"torque:cos(k*theta)\" = -0.02\nk = 6.0\n";
+    std::fs::write(&path, text).unwrap();
+    let file = read_model_file(&path).unwrap();
+    let Term::Law(law) = &file.terms[0].term else {
+        panic!("the law is read");
+    };
+    assert_eq!(law.shapes.harmonic, 6.0);
+    let written = motorcal::io::to_toml_string(&file);
+    assert!(written.contains("k = 6"), "{written}");
+    std::fs::write(&path, &written).unwrap();
+    assert_eq!(read_model_file(&path).unwrap(), file);
+    let bad = "schema = 2\n\n[terms.law]\n\"torque:sin(k*theta)\" = 0.01\nk = -1.0\n";
+    std::fs::write(&path, bad).unwrap();
+    let e = read_model_file(&path).unwrap_err().to_string();
+    assert!(e.contains("k"), "{e}");
+}
+
 #[test]
 fn a_model_file_with_a_law_reads_back_as_written() {
     let path = scratch("roundtrip");

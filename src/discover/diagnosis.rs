@@ -249,14 +249,34 @@ pub fn assemble(
         .flatten()
         .max_by(|a, b| a.score.total_cmp(&b.score));
     if let Some(fit) = best {
-        found = discovered(&fit, fit.score - selected_fit.score);
+        let before = selected_fit.score;
+        found = discovered(&fit, fit.score - before);
         selected_set = fit.added.clone();
         selected_fit = fit;
+        left = unexplained(problem, &selected_fit, &none, &as_given)?;
+        // A law taken, the verdict after it may find more in its balance (the other half of a
+        // ripple's phase, which the first fit's start did not hold): one more round, which may
+        // only extend the law, by the same threshold.
+        let extended = match (&found, &left) {
+            (Some(_), Some(verdict)) => fit_named_terms(
+                problem,
+                std::iter::once(&verdict.fingerprint).chain(&verdict.considered),
+                &[&selected_fit],
+                &selected_fit,
+                allowed,
+            )?
+            .filter(|fit| fit.added == selected_fit.added),
+            _ => None,
+        };
+        if let Some(fit) = extended {
+            found = discovered(&fit, fit.score - before);
+            selected_fit = fit;
+            left = unexplained(problem, &selected_fit, &none, &as_given)?;
+        }
         if selected_fit.added.len() == 1 {
             ranking.push(selected_fit.clone());
             ranking.sort_by(|a, b| b.score.total_cmp(&a.score));
         }
-        left = unexplained(problem, &selected_fit, &none, &as_given)?;
     }
     let passed_over: Vec<PassedOver> = passed_over
         .iter()

@@ -17,7 +17,10 @@ use serde::Serialize;
 
 use crate::error::Error;
 use crate::motor::Term;
-use crate::motor::dictionary::{self, BALANCES, FUNCTIONS, N_FUNCTIONS};
+use crate::motor::dictionary::{
+    self, BALANCES, COS_THETA, FUNCTIONS, N_FUNCTIONS, SIN_THETA, STRIBECK,
+};
+use crate::motor::terms::Law;
 use crate::parameter::ParamId;
 use crate::study::Problem;
 
@@ -67,16 +70,17 @@ pub fn named_term(problem: &Problem, fingerprint: &Fingerprint) -> Option<NamedT
             )
         }
         Fingerprint::State { .. } | Fingerprint::Drift { .. } => {
-            let (balance, functions, omega_s) = match fingerprint {
+            let (balance, functions, omega_s, harmonic) = match fingerprint {
                 Fingerprint::State {
                     balance,
                     functions,
                     omega_s,
+                    harmonic,
                     ..
-                } => (balance, functions, *omega_s),
+                } => (balance, functions, *omega_s, *harmonic),
                 Fingerprint::Drift {
                     balance, functions, ..
-                } => (balance, functions, None),
+                } => (balance, functions, None, None),
                 _ => return None,
             };
             let Some(Term::Law(law)) = Term::named("law") else {
@@ -93,6 +97,9 @@ pub fn named_term(problem: &Problem, fingerprint: &Fingerprint) -> Option<NamedT
             let mut law = law.with_active(keys);
             if let Some(w) = omega_s {
                 law.shapes.omega_s = w;
+            }
+            if let Some(k) = harmonic {
+                law.shapes.harmonic = k;
             }
             (Term::Law(law), start)
         }
@@ -125,9 +132,20 @@ fn fit_named(problem: &Problem, with: &Candidate, named: &NamedTerm) -> Result<C
     let search_penalty = named.search_penalty;
     let name = named.term.name().to_string();
     let mut added = with.added.clone();
-    added.push(name.clone());
+    let term = match (&named.term, law_of(with)) {
+        // A law named beside a fit that holds one already (the verdict after a law found more
+        // in the same balance: the other half of a ripple's phase) extends that law; its
+        // coefficients start at the fit's estimates, its shapes are kept where it has them.
+        (Term::Law(more), Some(held)) if with.added.contains(&name) => {
+            Term::Law(extended(held, more))
+        }
+        _ => {
+            added.push(name.clone());
+            named.term.clone()
+        }
+    };
     let mut starts = Starts {
-        terms: vec![named.term.clone()],
+        terms: vec![term],
         ..Starts::default()
     };
     for &(key, value) in &named.start {
@@ -139,6 +157,30 @@ fn fit_named(problem: &Problem, with: &Candidate, named: &NamedTerm) -> Result<C
         starts.search_penalty.insert(name, search_penalty);
     }
     fit_candidate_started(problem, &added, Some(with), &starts)
+}
+
+/// The law `fit`'s model holds, if one.
+fn law_of(fit: &Candidate) -> Option<&Law> {
+    fit.problem.model.terms.iter().find_map(|t| match &t.term {
+        Term::Law(law) => Some(law),
+        _ => None,
+    })
+}
+
+/// `held` with `more`'s functions as well; a shape (ω_s, k) `held` has no function of is
+/// taken from `more`.
+fn extended(held: &Law, more: &Law) -> Law {
+    let has = |law: &Law, fs: &[usize]| law.active.iter().any(|k| fs.contains(&(k % N_FUNCTIONS)));
+    let mut law = held
+        .clone()
+        .with_active(held.active.iter().chain(&more.active).copied().collect());
+    if !has(held, &[STRIBECK]) && has(more, &[STRIBECK]) {
+        law.shapes.omega_s = more.shapes.omega_s;
+    }
+    if !has(held, &[SIN_THETA, COS_THETA]) && has(more, &[SIN_THETA, COS_THETA]) {
+        law.shapes.harmonic = more.shapes.harmonic;
+    }
+    law
 }
 
 /// The best fit of a term the fingerprints name (every kind that cleared the threshold on its
@@ -207,6 +249,12 @@ pub struct Discovered {
     pub functions: Vec<DiscoveredFunction>,
     /// What adding it gained over the model selected before it (nats, the ranking's score).
     pub score: f64,
+    /// The Stribeck speed ω_s [rad/s], where the law holds the Stribeck function.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub omega_s: Option<f64>,
+    /// The angle's harmonic k (periods per revolution), where the law holds sin or cos(k·θ).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub k: Option<f64>,
     /// The law as the report prints it, e.g. `J dω/dt += −0.0001·sign(ω)·|I| [95%: …]`.
     pub equation: String,
 }
@@ -238,8 +286,13 @@ pub fn discovered(fit: &Candidate, gained: f64) -> Option<Discovered> {
             q975: value + half,
         });
     }
+    let holds = |f: usize| functions.iter().any(|g| g.name == FUNCTIONS[f]);
+    let omega_s = holds(STRIBECK).then_some(law.shapes.omega_s);
+    let k = (holds(SIN_THETA) || holds(COS_THETA)).then_some(law.shapes.harmonic);
     let mut law = Discovered {
         equation: String::new(),
+        omega_s,
+        k,
         balance: BALANCES[balance].to_string(),
         functions,
         score: gained,
@@ -255,7 +308,7 @@ impl Discovered {
             .iter()
             .map(|f| (f.name.clone(), f.coefficient, Some((f.q025, f.q975))))
             .collect();
-        self.equation = equation_with(&self.balance, &terms);
+        self.equation = with_harmonic(equation_with(&self.balance, &terms), self.k);
     }
 
     /// The sampled fit's posterior mean and 95% interval in place of the Laplace ones, where
@@ -272,5 +325,13 @@ impl Discovered {
             }
         }
         self.write_equation();
+    }
+}
+
+/// An equation with the angle's harmonic written in: `sin(6·θ)` for `sin(k·θ)` at k = 6.
+fn with_harmonic(equation: String, k: Option<f64>) -> String {
+    match k {
+        Some(k) => equation.replace("k·θ", &format!("{k}·θ")),
+        None => equation,
     }
 }

@@ -22,8 +22,8 @@ pub const FUNCTIONS: [&str; 18] = [
     "charge",
     "heat",
     "t",
-    "sin(theta)",
-    "cos(theta)",
+    "sin(k*theta)",
+    "cos(k*theta)",
     "sin(2*pi*f*t)",
     "cos(2*pi*f*t)",
     "U*charge",
@@ -35,13 +35,15 @@ pub const N_FUNCTIONS: usize = FUNCTIONS.len();
 /// The balances a law adds to, in the order of the law's parameters.
 pub const BALANCES: [&str; 2] = ["torque", "voltage"];
 
+/// The Stribeck function, whose speed ω_s is a shape.
+pub const STRIBECK: usize = 4;
 /// Functions that read the law's own states: the charge ∫|I|dt, the heat ∫R·I²dt, the angle
 /// θ = ∫ω dt (in the order of the law's states).
 pub const CHARGE: usize = 10;
 pub const HEAT: usize = 11;
 pub const TIME: usize = 12;
-const SIN_THETA: usize = 13;
-const COS_THETA: usize = 14;
+pub const SIN_THETA: usize = 13;
+pub const COS_THETA: usize = 14;
 /// The periodic functions of time, whose frequency is a setting.
 pub const PERIODIC: [usize; 2] = [15, 16];
 /// The input scaled by the charge drawn: a PWM drive's supply that sags as its battery
@@ -68,12 +70,15 @@ pub fn state_of(function: usize) -> Option<usize> {
 }
 
 /// The fixed shapes of the dictionary: the smoothing speed of sign(ω) (as Coulomb friction
-/// smooths it), the Stribeck speed ω_s and the frequency f of the periodic functions.
+/// smooths it), the Stribeck speed ω_s, the frequency f of the periodic functions of time and
+/// the harmonic k of the periodic functions of the angle (k periods per revolution: 1 for an
+/// eccentric load, the slot count for a cogging torque).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Shapes {
     pub omega_smooth: f64,
     pub omega_s: f64,
     pub frequency: f64,
+    pub harmonic: f64,
 }
 
 /// Where the functions are evaluated: the state, the input and the law's own states.
@@ -108,8 +113,8 @@ pub fn value<D: Scalar>(f: usize, x: &Point<D>, s: &Shapes) -> D {
         CHARGE => x.charge,
         HEAT => x.heat,
         TIME => D::from(x.t),
-        SIN_THETA => x.theta.sin(),
-        COS_THETA => x.theta.cos(),
+        SIN_THETA => (x.theta * s.harmonic).sin(),
+        COS_THETA => (x.theta * s.harmonic).cos(),
         15 => D::from(phase.sin()),
         16 => D::from(phase.cos()),
         U_CHARGE => x.voltage * x.charge,
@@ -196,4 +201,35 @@ pub fn pretty(name: &str) -> String {
         .replace("theta", "θ")
         .replace("2*pi*f*t", "2πft")
         .replace('*', "·")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// k periods per revolution: sin(k·θ) and cos(k·θ) at the harmonic the shapes hold.
+    #[test]
+    fn the_angle_functions_turn_k_times_per_revolution() {
+        let x = Point {
+            t: 0.0,
+            current: 1.0,
+            speed: 1.0,
+            voltage: 1.0,
+            charge: 0.0,
+            heat: 0.0,
+            theta: 0.3,
+        };
+        let shapes = |harmonic| Shapes {
+            omega_smooth: 1.0,
+            omega_s: 50.0,
+            frequency: 50.0,
+            harmonic,
+        };
+        assert_eq!(value(SIN_THETA, &x, &shapes(1.0)), 0.3f64.sin());
+        // 6·0.3 is 1.8 to the last bit or two.
+        assert!((value(SIN_THETA, &x, &shapes(6.0)) - 1.8f64.sin()).abs() < 1e-12);
+        assert!((value(COS_THETA, &x, &shapes(6.0)) - 1.8f64.cos()).abs() < 1e-12);
+        assert_eq!(FUNCTIONS[SIN_THETA], "sin(k*theta)");
+        assert_eq!(FUNCTIONS[COS_THETA], "cos(k*theta)");
+    }
 }

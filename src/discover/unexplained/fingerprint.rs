@@ -54,6 +54,10 @@ pub enum Fingerprint {
         /// of the functions.
         #[serde(skip_serializing_if = "Option::is_none")]
         omega_s: Option<f64>,
+        /// The harmonic k of `sin(k*theta)`, `cos(k*theta)` (periods per revolution), where
+        /// they are among the functions.
+        #[serde(rename = "k", skip_serializing_if = "Option::is_none")]
+        harmonic: Option<f64>,
         score: f64,
     },
     /// The balance drifts with time, the charge drawn or the heat dissipated: a state set of
@@ -165,12 +169,18 @@ impl Fingerprint {
                 seconds * 1e3
             ),
             Fingerprint::State {
-                balance, functions, ..
+                balance,
+                functions,
+                harmonic,
+                ..
             } => format!(
                 "the {balance} balance follows the state: {} fits what is left (the term \
                  law); a record with another input would confirm the law beyond this one's \
                  states",
-                equation(balance, functions)
+                match harmonic {
+                    Some(k) => equation(balance, functions).replace("k·θ", &format!("{k}·θ")),
+                    None => equation(balance, functions),
+                }
             ),
             Fingerprint::Drift {
                 variable,
@@ -269,12 +279,12 @@ mod tests {
                 Some((-0.0131, -0.0109)),
             ),
             ("omega".to_string(), -2.5e-5, None),
-            ("sin(theta)".to_string(), 0.25, None),
+            ("sin(k*theta)".to_string(), 0.25, None),
         ];
         assert_eq!(
             equation_with("torque", &law),
-            "J dω/dt += −0.012·sign(ω)·|I| [95%: −0.0131, −0.0109] − 2.50e-5·ω + 0.25·sin(θ)"
+            "J dω/dt += −0.012·sign(ω)·|I| [95%: −0.0131, −0.0109] − 2.50e-5·ω + 0.25·sin(k·θ)"
         );
-        assert!(equation_with("voltage", &law[2..]).starts_with("L dI/dt += 0.25·sin(θ)"));
+        assert!(equation_with("voltage", &law[2..]).starts_with("L dI/dt += 0.25·sin(k·θ)"));
     }
 }

@@ -24,15 +24,23 @@
 //! threshold then applies to it as to them.
 //!
 //! The Stribeck function's ω_s is a shape, not a coefficient: it is searched over a grid of
-//! shares of the record's speed scale, each value one more column tried. The periodic
-//! functions of time (frequency f a setting) are left to the oscillation alternative, which
-//! searches the frequency.
+//! shares of the record's speed scale, each value one more column tried. So is the harmonic k
+//! of sin(k·θ) and cos(k·θ) (an eccentric load's once per revolution, a cogging torque's slot
+//! count): each k of [`HARMONICS`] two more columns, one k at most in a law. A ripple in the
+//! angle has a phase, so the pair sin(k·θ), cos(k·θ) is also offered as one move, paying
+//! ½·ln N for each of its two coefficients: taken one at a time, neither half of a ripple whose
+//! phase is between them may clear the bar that the two clear together, and the first step
+//! would go to whatever single function mimics the ripple's start. The periodic functions of
+//! time (frequency f a setting) are left to the oscillation alternative, which searches the
+//! frequency.
 
 use nalgebra::DMatrix;
 
 use crate::error::Error;
 use crate::forward::ForwardModel;
-use crate::motor::dictionary::{self, FUNCTIONS, N_FUNCTIONS};
+use crate::motor::dictionary::{
+    self, COS_THETA, FUNCTIONS, N_FUNCTIONS, SIN_THETA, STRIBECK, Shapes,
+};
 use crate::motor::terms::Law;
 use crate::motor::{ActiveTerm, MotorModel, Term};
 
@@ -49,13 +57,38 @@ const STRIBECK_SHARES: [f64; 6] = [0.004, 0.008, 0.016, 0.032, 0.064, 0.128];
 /// At most this many functions per balance: a law longer than that is no longer a fingerprint.
 const MAX_FUNCTIONS: usize = 4;
 
-/// The dictionary's index of the Stribeck function.
-const STRIBECK: usize = 4;
+/// The harmonics k of sin(k·θ), cos(k·θ) tried, those the record samples
+/// ([`sampled_ripple`]): once per revolution (an eccentric or unbalanced load) up to the slot
+/// counts of small motors' cogging. Above a few kilohertz of
+/// k·ω/2π a ripple's torque is averaged by the inertia before the speed shows it, so larger k
+/// would be columns for chance alone.
+const HARMONICS: [f64; 7] = [1.0, 2.0, 3.0, 4.0, 6.0, 8.0, 12.0];
 
-/// A column of the regression: a function (dictionary index) and the Stribeck speed it has.
+/// Whether the record samples a ripple of `k` periods per revolution at least twice a period
+/// at its speed scale (the no-load speed at its largest input): k·ω·Δt < π. A faster ripple is
+/// one the samples alias and the inertia averages; its evidence would come from the slow
+/// passages alone, where a hump or a load looks the same, and its law's every solve resolves
+/// the ripple's periods (k = 8 on the paper's motor at 2400 rad/s: some 1500 in half a
+/// second), a fit of minutes for a term the record cannot confirm.
+fn sampled_ripple(k: f64, speed: f64, interval: f64) -> bool {
+    k * speed * interval < std::f64::consts::PI
+}
+
+/// A column of the regression: a function (dictionary index) and the shape it has, the
+/// Stribeck speed or the angle's harmonic.
 struct Column {
     function: usize,
     omega_s: Option<f64>,
+    harmonic: Option<f64>,
+}
+
+/// How a block of columns shapes the law it is evaluated on.
+#[derive(Clone, Copy)]
+enum Shape {
+    /// The model's law's shapes (or the dictionary's defaults).
+    Own,
+    StribeckSpeed(f64),
+    Harmonic(f64),
 }
 
 /// The whitened sensitivities of the law's coefficients `keys` (parameter indices) at `fit`'s
@@ -63,7 +96,8 @@ struct Column {
 fn law_columns(
     fit: &Candidate,
     ctx: &Context,
-    law: Law,
+    law: &Law,
+    shape: Shape,
     keys: &[usize],
 ) -> Result<DMatrix<f64>, Error> {
     let forward = fit.posterior.forward(0);
@@ -76,6 +110,7 @@ fn law_columns(
         .collect();
     let mut values = vec![0.0; 2 * N_FUNCTIONS];
     let mut active = keys.to_vec();
+    let mut shapes: Shapes = law.shapes;
     // A law the model already holds keeps its functions and values; its columns are the
     // model's own, which the projection removes.
     if let Some(t) = model
@@ -86,10 +121,18 @@ fn law_columns(
         values.copy_from_slice(&t.values);
         if let Term::Law(own) = &t.term {
             active.extend(&own.active);
+            shapes = own.shapes;
         }
     }
+    match shape {
+        Shape::Own => {}
+        Shape::StribeckSpeed(w) => shapes.omega_s = w,
+        Shape::Harmonic(k) => shapes.harmonic = k,
+    }
+    let mut shaped = law.clone().with_active(active);
+    shaped.shapes = shapes;
     terms.push(ActiveTerm {
-        term: Term::Law(law.with_active(active)),
+        term: Term::Law(shaped),
         values,
     });
     let with_law = MotorModel::with_base(
@@ -143,44 +186,92 @@ pub(super) fn fingerprints(
     let Some(Term::Law(law)) = Term::named("law") else {
         return Ok(Vec::new());
     };
+    // The shapes the model's own law fixes already: its columns are the model's, so only its
+    // own ω_s and k are tried where it holds those functions.
+    let own = model.terms().iter().find_map(|t| match &t.term {
+        Term::Law(l) => Some(l.clone()),
+        _ => None,
+    });
+    let holds = |f: usize| {
+        own.as_ref()
+            .is_some_and(|l| l.active.iter().any(|k| k % N_FUNCTIONS == f))
+    };
+    let speed = model.magnitudes(ctx.times[ctx.n - 1]).speed;
+    let stribeck_speeds: Vec<f64> = match &own {
+        Some(l) if holds(STRIBECK) => vec![l.shapes.omega_s],
+        _ => STRIBECK_SHARES.iter().map(|s| s * speed).collect(),
+    };
+    let harmonics: Vec<f64> = match &own {
+        Some(l) if holds(SIN_THETA) || holds(COS_THETA) => vec![l.shapes.harmonic],
+        _ => {
+            let interval = (ctx.times[ctx.n - 1] - ctx.times[0]) / (ctx.n - 1).max(1) as f64;
+            HARMONICS
+                .into_iter()
+                .filter(|&k| sampled_ripple(k, speed, interval))
+                .collect()
+        }
+    };
     let plain: Vec<usize> = (0..N_FUNCTIONS)
-        .filter(|&f| f != STRIBECK && !dictionary::PERIODIC.contains(&f))
+        .filter(|&f| f != STRIBECK && f != SIN_THETA && f != COS_THETA)
+        .filter(|f| !dictionary::PERIODIC.contains(f))
         .collect();
     let mut columns: Vec<Column> = Vec::new();
-    let mut blocks: Vec<DMatrix<f64>> = Vec::new();
-    // Torque columns then voltage columns, per block: block j holds the balance-major keys.
-    let keys: Vec<usize> = (0..2)
-        .flat_map(|b| plain.iter().map(move |&f| b * N_FUNCTIONS + f))
-        .collect();
-    blocks.push(law_columns(fit, ctx, law.clone(), &keys)?);
-    columns.extend(plain.iter().map(|&f| Column {
-        function: f,
-        omega_s: None,
-    }));
-    let speed = model.magnitudes(ctx.times[ctx.n - 1]).speed;
-    for share in STRIBECK_SHARES {
-        let mut shaped = law.clone();
-        shaped.shapes.omega_s = share * speed;
-        let keys = [STRIBECK, N_FUNCTIONS + STRIBECK];
-        blocks.push(law_columns(fit, ctx, shaped, &keys)?);
-        columns.push(Column {
-            function: STRIBECK,
-            omega_s: Some(share * speed),
-        });
+    // Per block, its functions; its columns are balance-major (torque's, then voltage's).
+    let mut blocks: Vec<(Vec<usize>, DMatrix<f64>)> = Vec::new();
+    let mut add = |functions: Vec<usize>, shape: Shape| -> Result<(), Error> {
+        let keys: Vec<usize> = (0..2)
+            .flat_map(|b| functions.iter().map(move |&f| b * N_FUNCTIONS + f))
+            .collect();
+        let b = law_columns(fit, ctx, &law, shape, &keys)?;
+        for &f in &functions {
+            columns.push(Column {
+                function: f,
+                omega_s: match shape {
+                    Shape::StribeckSpeed(w) => Some(w),
+                    _ => None,
+                },
+                harmonic: match shape {
+                    Shape::Harmonic(k) => Some(k),
+                    _ => None,
+                },
+            });
+        }
+        blocks.push((functions, b));
+        Ok(())
+    };
+    add(plain, Shape::Own)?;
+    for w in stribeck_speeds {
+        add(vec![STRIBECK], Shape::StribeckSpeed(w))?;
+    }
+    for k in harmonics {
+        add(vec![SIN_THETA, COS_THETA], Shape::Harmonic(k))?;
     }
     let mut out = Vec::new();
     for balance in 0..2 {
         // The balance's column of each regressor, in `columns`' order.
         let mut b = DMatrix::zeros(ctx.m(), columns.len());
-        for j in 0..plain.len() {
-            b.set_column(j, &blocks[0].column(balance * plain.len() + j));
-        }
-        for s in 0..STRIBECK_SHARES.len() {
-            b.set_column(plain.len() + s, &blocks[1 + s].column(balance));
+        let mut j = 0;
+        for (functions, block) in &blocks {
+            for i in 0..functions.len() {
+                b.set_column(j, &block.column(balance * functions.len() + i));
+                j += 1;
+            }
         }
         let b_tilde = ctx.projector.residualize(&b);
-        if let Some(e) = select(ctx, &columns, &b_tilde, balance, shift) {
-            out.push(e);
+        let first = select(ctx, &columns, &b_tilde, balance, shift, |_| true);
+        // A ripple in the angle on its own as well, where the selection took another
+        // function first: on a record that spins up from rest the ripple's net early push is
+        // what a Stribeck hump also gives, and to first order the two are near; the fits
+        // through the ODE (`named::fit_named_terms`) decide between the laws.
+        let took_angle = |e: &Evidence| match &e.fingerprint {
+            Fingerprint::State { harmonic, .. } => harmonic.is_some(),
+            _ => false,
+        };
+        let add_ripple = first.as_ref().is_some_and(|e| !took_angle(e));
+        out.extend(first);
+        if add_ripple {
+            let angle = |f: usize| f == SIN_THETA || f == COS_THETA;
+            out.extend(select(ctx, &columns, &b_tilde, balance, shift, angle));
         }
     }
     Ok(out)
@@ -194,35 +285,56 @@ fn select(
     b_tilde: &DMatrix<f64>,
     balance: usize,
     shift: f64,
+    offered: impl Fn(usize) -> bool,
 ) -> Option<Evidence> {
     let mut chosen: Vec<usize> = Vec::new();
     let (mut current, mut score) = (0.0, 0.0);
     while chosen.len() < MAX_FUNCTIONS {
-        // One Stribeck speed at most: the law has one ω_s.
-        let stribeck_taken = chosen.iter().any(|&j| columns[j].omega_s.is_some());
+        // One Stribeck speed and one harmonic at most: the law has one ω_s and one k.
+        let stribeck = chosen.iter().find_map(|&j| columns[j].omega_s);
+        let harmonic = chosen.iter().find_map(|&j| columns[j].harmonic);
         let open: Vec<usize> = (0..columns.len())
             .filter(|j| !chosen.contains(j))
-            .filter(|&j| !(stribeck_taken && columns[j].omega_s.is_some()))
-            .filter(|&j| dictionary::offered_in(columns[j].function, balance))
-            .collect();
-        if open.is_empty() {
-            break;
-        }
-        let price = 0.5 * ctx.ln_n + (open.len() as f64).ln();
-        let best = open
-            .iter()
-            .map(|&j| {
-                let mut set = chosen.clone();
-                set.push(j);
-                (j, gain(&ctx.y, &b_tilde.select_columns(&set)))
+            .filter(|&j| stribeck.is_none() || columns[j].omega_s.is_none())
+            .filter(|&j| {
+                harmonic.is_none() || columns[j].harmonic.is_none_or(|k| Some(k) == harmonic)
             })
-            .max_by(|a, b| a.1.total_cmp(&b.1))?;
-        if best.1 - current <= price + EVIDENCE_THRESHOLD {
+            .filter(|&j| dictionary::offered_in(columns[j].function, balance))
+            .filter(|&j| offered(columns[j].function))
+            .collect();
+        // The moves: each open column, and each harmonic's sin and cos together.
+        let mut moves: Vec<Vec<usize>> = open.iter().map(|&j| vec![j]).collect();
+        for &j in open.iter().filter(|&&j| columns[j].function == SIN_THETA) {
+            let k = columns[j].harmonic;
+            let cos = open
+                .iter()
+                .find(|&&c| columns[c].function == COS_THETA && columns[c].harmonic == k);
+            if let Some(&c) = cos
+                && chosen.len() + 2 <= MAX_FUNCTIONS
+            {
+                moves.push(vec![j, c]);
+            }
+        }
+        if moves.is_empty() {
             break;
         }
-        score += best.1 - current - price;
+        let look_elsewhere = (moves.len() as f64).ln();
+        let best = moves
+            .iter()
+            .map(|m| {
+                let mut set = chosen.clone();
+                set.extend(m);
+                let g = gain(&ctx.y, &b_tilde.select_columns(&set));
+                let price = 0.5 * ctx.ln_n * m.len() as f64 + look_elsewhere;
+                (m, g, g - current - price)
+            })
+            .max_by(|a, b| a.2.total_cmp(&b.2))?;
+        if best.2 <= EVIDENCE_THRESHOLD {
+            break;
+        }
+        score += best.2;
         current = best.1;
-        chosen.push(best.0);
+        chosen.extend(best.0);
     }
     if chosen.is_empty() {
         return None;
@@ -258,6 +370,7 @@ fn select(
             balance,
             functions,
             omega_s: chosen.iter().find_map(|&j| columns[j].omega_s),
+            harmonic: chosen.iter().find_map(|&j| columns[j].harmonic),
             score: score - shift,
         }
     };
@@ -266,4 +379,22 @@ fn select(
         residual: ctx.y.as_slice().to_vec(),
         explained: e.fitted.as_slice().to_vec(),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn only_the_ripples_the_samples_resolve_are_offered() {
+        // The paper's motor at 24 V turns at some 2400 rad/s, sampled every millisecond: 2.4 rad
+        // a sample, so once per revolution is resolved and twice is not.
+        let offered: Vec<f64> = HARMONICS
+            .into_iter()
+            .filter(|&k| sampled_ripple(k, 2400.0, 1e-3))
+            .collect();
+        assert_eq!(offered, vec![1.0]);
+        // A positioning stage at 10 rad/s resolves every slot count of the grid.
+        assert!(HARMONICS.iter().all(|&k| sampled_ripple(k, 10.0, 1e-3)));
+    }
 }

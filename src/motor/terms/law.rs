@@ -100,8 +100,8 @@ impl PhysicsTerm for Law {
         10 "charge" "N·m/(A·s)" "V/(A·s)",
         11 "heat" "N·m/J" "V/J",
         12 "t" "N·m/s" "V/s",
-        13 "sin(theta)" "N·m" "V",
-        14 "cos(theta)" "N·m" "V",
+        13 "sin(k*theta)" "N·m" "V",
+        14 "cos(k*theta)" "N·m" "V",
         15 "sin(2*pi*f*t)" "N·m" "V",
         16 "cos(2*pi*f*t)" "N·m" "V",
         17 "U*charge" "N·m/(V·A·s)" "1/(A·s)",
@@ -128,6 +128,13 @@ impl PhysicsTerm for Law {
             speed_share: None,
             choices: &[],
         },
+        TermSetting {
+            key: "k",
+            unit: "1/rev",
+            default: 1.0,
+            speed_share: None,
+            choices: &[],
+        },
     ];
     const STATES: &'static [TermState] = &[
         TermState {
@@ -151,6 +158,7 @@ impl PhysicsTerm for Law {
                 omega_smooth: positive_setting(Self::NAME, "omega_smooth", s[0])?,
                 omega_s: positive_setting(Self::NAME, "omega_s", s[1])?,
                 frequency: positive_setting(Self::NAME, "f", s[2])?,
+                harmonic: positive_setting(Self::NAME, "k", s[3])?,
             },
         })
     }
@@ -160,6 +168,7 @@ impl PhysicsTerm for Law {
             self.shapes.omega_smooth,
             self.shapes.omega_s,
             self.shapes.frequency,
+            self.shapes.harmonic,
         ]
     }
 
