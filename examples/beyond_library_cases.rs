@@ -63,6 +63,9 @@ enum Effect {
     ResonantSensor { f_n: f64, zeta: f64 },
     /// A torque ripple once per revolution of an eccentric load: a·sin(θ + φ).
     Eccentric { a: f64, phase: f64 },
+    /// A cogging torque, k periods per revolution (the slots): a·sin(kθ + φ). Not among the
+    /// default effects (the set of nine keeps its seeds); `--effects cogging`.
+    Cogging { a: f64, k: u32, phase: f64 },
     /// The input acting τ late.
     InputDelay { tau: f64 },
     /// One channel (0: I, 1: ω) read through a first-order filter of time constant τ.
@@ -104,6 +107,11 @@ impl Effect {
                 a: 1e-3,
                 phase: rng.random_range(0.0..2.0 * PI),
             },
+            "cogging" => Effect::Cogging {
+                a: 1e-3,
+                k: rng.random_range(2..=12u32),
+                phase: rng.random_range(0.0..2.0 * PI),
+            },
             "input_delay" => Effect::InputDelay { tau: 1e-4 },
             "sensor_lag" => Effect::SensorLag {
                 tau: 1e-4,
@@ -123,7 +131,9 @@ impl Effect {
     fn size(&self) -> f64 {
         match *self {
             Effect::Stribeck { t_c, .. } => t_c,
-            Effect::PeriodicLoad { a, .. } | Effect::Eccentric { a, .. } => a,
+            Effect::PeriodicLoad { a, .. }
+            | Effect::Eccentric { a, .. }
+            | Effect::Cogging { a, .. } => a,
             Effect::LoadFriction { mu } => mu,
             Effect::SaggingSupply { kappa } => kappa,
             Effect::ResonantSensor { f_n, .. } => 1.0 / f_n,
@@ -136,7 +146,9 @@ impl Effect {
         let mut e = *self;
         match &mut e {
             Effect::Stribeck { t_c, .. } => *t_c = s,
-            Effect::PeriodicLoad { a, .. } | Effect::Eccentric { a, .. } => *a = s,
+            Effect::PeriodicLoad { a, .. }
+            | Effect::Eccentric { a, .. }
+            | Effect::Cogging { a, .. } => *a = s,
             Effect::LoadFriction { mu } => *mu = s,
             Effect::SaggingSupply { kappa } => *kappa = s,
             Effect::ResonantSensor { f_n, .. } => *f_n = 1.0 / s,
@@ -213,6 +225,10 @@ fn rhs(
         }
         Some(&Effect::Eccentric { a, phase }) => {
             torque -= a * (x[2] + phase).sin();
+            dx[2] = w;
+        }
+        Some(&Effect::Cogging { a, k, phase }) => {
+            torque -= a * (k as f64 * x[2] + phase).sin();
             dx[2] = w;
         }
         Some(&Effect::InputDelay { tau }) => u = input.at(t - tau, times),
@@ -343,6 +359,7 @@ fn expected(e: &Effect) -> String {
         Effect::SaggingSupply { .. } => r#"{"kind": "drift", "variable": "charge"}"#.into(),
         Effect::ResonantSensor { f_n, zeta } => format!(r#"{{"kind": "oscillation", "frequency_hz": {}, "damping_ratio": {zeta}, "channel": "omega", "ringing": true}}"#, f_n * (1.0 - zeta * zeta).sqrt()),
         Effect::Eccentric { .. } => r#"{"kind": "state", "balance": "torque", "functions": ["sin(k*theta)", "cos(k*theta)"], "k": 1}"#.into(),
+        Effect::Cogging { k, .. } => format!(r#"{{"kind": "state", "balance": "torque", "functions": ["sin(k*theta)", "cos(k*theta)"], "k": {k}}}"#),
         Effect::InputDelay { tau } => format!(r#"{{"kind": "delay", "seconds": {tau}}}"#),
         Effect::SensorLag { tau, channel } => format!(r#"{{"kind": "lag", "channel": "{}", "seconds": {tau}}}"#, ["I", "omega"][channel]),
         Effect::CompliantCoupling { f, zeta, share } => {
