@@ -13,7 +13,7 @@
 //! `truth.csv` (the recording without its noise).
 //!
 //! cargo run --release --example beyond_library_cases -- [--out DIR] [--per-effect 3]
-//!     [--seed-base 510000] [--min-nats 20] [--max-nats 300] [--effects a,b,…]
+//!     [--seed-base 510000] [--min-nats 20] [--max-nats 300] [--effects a,b,…] [--volts 24]
 
 use std::f64::consts::PI;
 use std::fmt::Write as _;
@@ -171,9 +171,11 @@ impl Effect {
 }
 
 /// The input: a constant 24 V (type A) or the held profile (type B), each row's value applying
-/// from its time on.
+/// from its time on; `--volts` scales both (a slow record, on which a ripple of many periods per
+/// revolution is sampled).
 #[derive(Clone, Debug)]
 struct Input {
+    level: f64,
     held: Option<Vec<f64>>,
 }
 
@@ -183,7 +185,7 @@ impl Input {
             return 0.0;
         }
         match &self.held {
-            None => 24.0,
+            None => self.level,
             Some(values) => {
                 let i = times.partition_point(|&ti| ti <= t);
                 values[i.saturating_sub(1).min(values.len() - 1)]
@@ -385,6 +387,8 @@ fn main() {
     let seed_base: u64 = arg(&args, "--seed-base", 510_000);
     let min_nats: f64 = arg(&args, "--min-nats", 20.0);
     let max_nats: f64 = arg(&args, "--max-nats", 300.0);
+    let volts: f64 = arg(&args, "--volts", 24.0);
+    let scale = volts / 24.0;
     let effects: Vec<String> = arg(&args, "--effects", Effect::NAMES.join(","))
         .split(',')
         .map(String::from)
@@ -402,23 +406,28 @@ fn main() {
                 let t2 = rng.random_range(0.28..0.36);
                 let mid = if rng.random_bool(0.5) { 8.0 } else { 12.0 };
                 Input {
+                    level: volts,
                     held: Some(
                         times
                             .iter()
                             .map(|&t| {
-                                if t < t1 {
-                                    24.0
-                                } else if t < t2 {
-                                    mid
-                                } else {
-                                    -24.0
-                                }
+                                scale
+                                    * if t < t1 {
+                                        24.0
+                                    } else if t < t2 {
+                                        mid
+                                    } else {
+                                        -24.0
+                                    }
                             })
                             .collect(),
                     ),
                 }
             } else {
-                Input { held: None }
+                Input {
+                    level: volts,
+                    held: None,
+                }
             };
             let shape = Effect::draw(name, &mut rng);
             let target = (min_nats.ln() + rng.random::<f64>() * (max_nats / min_nats).ln()).exp();
@@ -492,7 +501,7 @@ fn main() {
             std::fs::write(
                 dir.join("motor.toml"),
                 format!(
-                    "schema = 1\n\n[motor]\nR = 0.1\nc_m = 0.01\nc_g = 0.01\nU = 24.0\nd = 1e-6\nL = 0.0001\nJ = 5e-5\nI0 = 0.0\nomega0 = 0.0\n\n[channels]\nt = \"t\"\nI = \"I\"\nomega = \"omega\"\n{channels}"
+                    "schema = 1\n\n[motor]\nR = 0.1\nc_m = 0.01\nc_g = 0.01\nU = {volts:?}\nd = 1e-6\nL = 0.0001\nJ = 5e-5\nI0 = 0.0\nomega0 = 0.0\n\n[channels]\nt = \"t\"\nI = \"I\"\nomega = \"omega\"\n{channels}"
                 ),
             )
             .unwrap();
