@@ -100,6 +100,39 @@ fn a_ripple_on_a_spin_up_from_rest_is_told_from_a_stribeck_hump_by_the_fit() {
     assert_the_ripple_is_discovered("eccentric-510006");
 }
 
+/// A cogging torque, −a·sin(k·θ + φ), on a slow record (2 V: some 200 rad/s, so that every
+/// slot count of the grid is sampled twice a period): the law is found in the angle at the
+/// truth's k, and nothing is left; at k = 2 its amplitude is within 30% of a. (At 24 V the
+/// same ripples are not sampled and the fingerprint does not offer them.)
+#[test]
+fn a_cogging_torque_on_a_slow_record_is_discovered_at_its_slot_count() {
+    for case in ["cogging-530001", "cogging-530007"] {
+        let (problem, answer) = fixture(case);
+        let d = diagnose(&problem);
+        let law = d.discovered.expect("a law is discovered");
+        assert_eq!(law.balance, "torque");
+        assert!(
+            law.functions
+                .iter()
+                .all(|f| f.name == "sin(k*theta)" || f.name == "cos(k*theta)"),
+            "{case}: {:?}",
+            law.functions
+        );
+        assert_eq!(law.k, Some(truth_value(&answer, "k")), "{case}");
+        assert!(d.unexplained.is_none(), "{case}: {:?}", d.unexplained);
+        if law.k == Some(2.0) {
+            let a = truth_value(&answer, "a");
+            let amplitude = law
+                .functions
+                .iter()
+                .map(|f| f.coefficient * f.coefficient)
+                .sum::<f64>()
+                .sqrt();
+            assert!(within(amplitude, a, 0.3), "{case}: {amplitude} vs {a}");
+        }
+    }
+}
+
 /// The law sin θ, cos θ at k = 1 in the torque balance, its amplitude within 30% of the
 /// truth's a, and nothing left unexplained.
 fn assert_the_ripple_is_discovered(case: &str) {
