@@ -7,7 +7,7 @@
 
 use std::path::{Path, PathBuf};
 
-use motorcal::discover::{Diagnosis, DiscoverSettings, discover};
+use motorcal::discover::{Diagnosis, DiscoverSettings, Discovered, discover};
 use motorcal::study::cases::{CaseOptions, make_case};
 use motorcal::study::{InputProfile, Problem};
 
@@ -121,13 +121,7 @@ fn a_cogging_torque_on_a_slow_record_is_discovered_at_its_slot_count() {
         assert_eq!(law.k, Some(truth_value(&answer, "k")), "{case}");
         assert!(d.unexplained.is_none(), "{case}: {:?}", d.unexplained);
         if law.k == Some(2.0) {
-            let a = truth_value(&answer, "a");
-            let amplitude = law
-                .functions
-                .iter()
-                .map(|f| f.coefficient * f.coefficient)
-                .sum::<f64>()
-                .sqrt();
+            let (amplitude, a) = (amplitude(&law), truth_value(&answer, "a"));
             assert!(within(amplitude, a, 0.3), "{case}: {amplitude} vs {a}");
         }
     }
@@ -146,14 +140,18 @@ fn assert_the_ripple_is_discovered(case: &str) {
     assert_eq!(names, ["cos(k*theta)", "sin(k*theta)"]);
     assert_eq!(law.k, Some(1.0), "once per revolution");
     assert!(law.equation.contains("1·θ"), "{}", law.equation);
-    let amplitude = law
-        .functions
+    let amplitude = amplitude(&law);
+    assert!(within(amplitude, a, 0.3), "{amplitude} vs {a}");
+    assert!(d.unexplained.is_none(), "{:?}", d.unexplained);
+}
+
+/// A ripple's amplitude from its sine and cosine coefficients, √(c_s² + c_c²).
+fn amplitude(law: &Discovered) -> f64 {
+    law.functions
         .iter()
         .map(|f| f.coefficient * f.coefficient)
         .sum::<f64>()
-        .sqrt();
-    assert!(within(amplitude, a, 0.3), "{amplitude} vs {a}");
-    assert!(d.unexplained.is_none(), "{:?}", d.unexplained);
+        .sqrt()
 }
 
 /// A PWM drive whose battery sags with the charge drawn applies U·(1 − κ·q), q = ∫|I|dt. On a
