@@ -1,13 +1,16 @@
 //! Discovering the law: effects no library term holds, simulated outside the crate's model by
 //! the independent RK4 integrator of `examples/beyond_library_cases.rs` (seeds 510006, 510012,
-//! 510013 and 510015 of `--per-effect 2 --seed-base 510000`, the answer beside each recording), leave a
-//! state fingerprint; the law term written from it is fitted, taken by the ranking's threshold,
+//! 510013 and 510015 of `--per-effect 2 --seed-base 510000`; supply ripples 560004 and 560012 of
+//! `--effects flux_saturation,thermal_magnet,current_limit,supply_ripple --per-effect 3
+//! --seed-base 560000`, as is current_limit-560011; the answer beside each recording), leave a state fingerprint or a
+//! forced oscillation; the law term written from it is fitted, taken by the ranking's threshold,
 //! and holds the true functions with coefficients near the truth, leaving nothing. Null
 //! records of the crate's own generator, with every candidate allowed, discover nothing.
 
 use std::path::{Path, PathBuf};
 
 use motorcal::discover::{Diagnosis, DiscoverSettings, Discovered, discover};
+use motorcal::motor::MotorParam;
 use motorcal::study::cases::{CaseOptions, make_case};
 use motorcal::study::{InputProfile, Problem};
 
@@ -175,6 +178,64 @@ fn a_supply_sagging_with_the_charge_is_discovered_in_place_of_library_terms_stan
         -kappa
     );
     assert_eq!(d.selected_set, ["law"]);
+}
+
+/// A rectified supply's ripple, U·(1 + ε·cos 2πft) on a constant input (no term of the library
+/// is periodic in time): the verdict's oscillation runs on regardless of the input, and the law
+/// it names, sin and cos(2πft) at the verdict's frequency, is taken in the voltage balance —
+/// the frequency within 2% of f, the ripple's amplitude within 30% of ε·U — and nothing is
+/// left. Its score paid the frequency search's ln G beside the coefficients' ½·ln N.
+#[test]
+fn a_supply_ripple_is_discovered_as_a_periodic_law_in_the_voltage_balance() {
+    for case in ["supply_ripple-560004", "supply_ripple-560012"] {
+        let (problem, answer) = fixture(case);
+        let (eps, f) = (truth_value(&answer, "eps"), truth_value(&answer, "f"));
+        let d = diagnose(&problem);
+        let law = d.discovered.expect("a law is discovered");
+        assert_eq!(law.balance, "voltage", "{case}");
+        let mut names: Vec<&str> = law.functions.iter().map(|f| f.name.as_str()).collect();
+        names.sort();
+        assert_eq!(names, ["cos(2*pi*f*t)", "sin(2*pi*f*t)"], "{case}");
+        let found = law.frequency_hz.expect("the law's frequency is reported");
+        assert!(within(found, f, 0.02), "{case}: {found} Hz vs {f}");
+        assert!(
+            law.equation.contains(&format!("2π·{found:.2}·t")),
+            "{}",
+            law.equation
+        );
+        let u = problem.model.motor.get(MotorParam::Voltage);
+        let amplitude = amplitude(&law);
+        assert!(
+            within(amplitude, eps * u, 0.3),
+            "{case}: {amplitude} vs {}",
+            eps * u
+        );
+        assert!(d.unexplained.is_none(), "{case}: {:?}", d.unexplained);
+    }
+}
+
+/// A drive's current limit, a loop that takes G·(|I| − I_max) volts off above I_max (no term
+/// of the library holds a limit): the law in the voltage balance in the current beyond a
+/// limit, the limit within 5% of I_max and its gain negative (volts taken off), nothing left.
+/// The gain itself is weakly held (a stiff loop and a stiffer one hold the current alike).
+#[test]
+fn a_drives_current_limit_is_discovered_with_its_level() {
+    let (problem, answer) = fixture("current_limit-560011");
+    let i_max = truth_value(&answer, "i_max");
+    let d = diagnose(&problem);
+    let law = d.discovered.expect("a law is discovered");
+    assert_eq!(law.balance, "voltage");
+    let names: Vec<&str> = law.functions.iter().map(|f| f.name.as_str()).collect();
+    assert_eq!(names, ["sign(I)*max(|I|-I_lim,0)"]);
+    let limit = law.current_limit.expect("the limit is reported");
+    assert!(within(limit, i_max, 0.05), "{limit} A vs {i_max}");
+    assert!(law.functions[0].coefficient < 0.0, "{}", law.equation);
+    assert!(
+        law.equation.contains(&format!("{limit:.1} A")),
+        "{}",
+        law.equation
+    );
+    assert!(d.unexplained.is_none(), "{:?}", d.unexplained);
 }
 
 /// Where a library term holds the effect, the law the model as given asks for is that term

@@ -69,7 +69,7 @@ pub use coincide::{InputCoincidence, InputStep, input_steps};
 pub use confirm::importance_evidence;
 pub use diagnosis::{Diagnosis, PassedOver, RankEntry, StageFit};
 pub use fits::{FitSummary, Mismatch, SampledFit, Whiteness, ljung_box};
-pub use named::{Discovered, DiscoveredFunction, NamedTerm, named_term};
+pub use named::{Discovered, DiscoveredFunction, NamedTerm, named_term, named_terms};
 pub use selection::{Selection, forward_selection, rank};
 pub use settings::{
     DEFAULT_K, DiscoverSettings, EVIDENCE_THRESHOLD, FitStage, LAPLACE_ABOVE_SAMPLES,

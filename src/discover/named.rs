@@ -1,7 +1,9 @@
 //! The dynamic term a fingerprint names, fitted from the fingerprint's estimate: a delay names
 //! `input_delay` (τ), a lag names `sensor_lag` on its channel (τ), a resonance that rings after
 //! the input steps names `compliant_coupling` (f_r and ζ; the load's share from several
-//! starts); a state or drift fingerprint names the `law` with its functions. The dynamic terms
+//! starts); an oscillation that runs on regardless of the input (a forced one: a pulsing load,
+//! a rectified supply's ripple) names the `law` in sin and cos(2πft) at its frequency, in either
+//! balance; a state or drift fingerprint names the `law` with its functions. The dynamic terms
 //! are also ranked with the library (started from the same estimates, `unexplained::starts`);
 //! this is the second chance for what the selected model still leaves.
 //!
@@ -18,7 +20,7 @@ use serde::Serialize;
 use crate::error::Error;
 use crate::motor::Term;
 use crate::motor::dictionary::{
-    self, BALANCES, COS_THETA, FUNCTIONS, N_FUNCTIONS, SIN_THETA, STRIBECK,
+    self, BALANCES, COS_THETA, CURRENT_LIMIT, FUNCTIONS, N_FUNCTIONS, PERIODIC, SIN_THETA, STRIBECK,
 };
 use crate::motor::terms::Law;
 use crate::parameter::ParamId;
@@ -36,6 +38,45 @@ pub struct NamedTerm {
     /// What its score pays for the grid its start was the best of (a frequency's ln G in
     /// place of its ½·ln N: `unexplained::frequency_search_cost`).
     pub search_penalty: f64,
+}
+
+/// The terms `fingerprint` names on `problem`'s base: one, or none; a forced oscillation, whose
+/// channel does not say which balance it enters (a ripple of the supply shows in ω as a load's
+/// shows in I), names a law in each.
+pub fn named_terms(problem: &Problem, fingerprint: &Fingerprint) -> Vec<NamedTerm> {
+    match fingerprint {
+        Fingerprint::Oscillation {
+            frequency_hz,
+            ringing: false,
+            sensor: false,
+            frequencies,
+            ..
+        } => (0..BALANCES.len())
+            .filter_map(|b| forced_law(problem, b, *frequency_hz, *frequencies))
+            .collect(),
+        _ => named_term(problem, fingerprint).into_iter().collect(),
+    }
+}
+
+/// A law in balance `b` of sin and cos(2πft) at the frequency `f` a search over `frequencies`
+/// found. The frequency is a setting of the law, not one of its parameters, so its score pays
+/// the search's whole look-elsewhere cost ln G on top of the two coefficients' ½·ln N each
+/// (the coupling's frequency, a parameter, pays ln G in place of its ½·ln N).
+fn forced_law(problem: &Problem, b: usize, f: f64, frequencies: usize) -> Option<NamedTerm> {
+    let Some(Term::Law(law)) = Term::named("law") else {
+        return None;
+    };
+    let keys: Vec<usize> = PERIODIC.iter().map(|&p| b * N_FUNCTIONS + p).collect();
+    let start = keys.iter().map(|&k| (law_key(k), 0.0)).collect();
+    let mut law = law.with_active(keys);
+    law.shapes.frequency = f;
+    let present = problem.model.terms.iter().any(|t| t.term.name() == "law");
+    let term = Term::Law(law);
+    (problem.model.base.accepts(&term) && !present).then_some(NamedTerm {
+        term,
+        start,
+        search_penalty: (frequencies.max(1) as f64).ln(),
+    })
 }
 
 /// The term `fingerprint` names on `problem`'s base, if one does.
@@ -70,17 +111,18 @@ pub fn named_term(problem: &Problem, fingerprint: &Fingerprint) -> Option<NamedT
             )
         }
         Fingerprint::State { .. } | Fingerprint::Drift { .. } => {
-            let (balance, functions, omega_s, harmonic) = match fingerprint {
+            let (balance, functions, omega_s, harmonic, current_limit) = match fingerprint {
                 Fingerprint::State {
                     balance,
                     functions,
                     omega_s,
                     harmonic,
+                    current_limit,
                     ..
-                } => (balance, functions, *omega_s, *harmonic),
+                } => (balance, functions, *omega_s, *harmonic, *current_limit),
                 Fingerprint::Drift {
                     balance, functions, ..
-                } => (balance, functions, None, None),
+                } => (balance, functions, None, None, None),
                 _ => return None,
             };
             let Some(Term::Law(law)) = Term::named("law") else {
@@ -100,6 +142,9 @@ pub fn named_term(problem: &Problem, fingerprint: &Fingerprint) -> Option<NamedT
             }
             if let Some(k) = harmonic {
                 law.shapes.harmonic = k;
+            }
+            if let Some(i) = current_limit {
+                law.shapes.current_limit = i;
             }
             (Term::Law(law), start)
         }
@@ -180,6 +225,9 @@ fn extended(held: &Law, more: &Law) -> Law {
     if !has(held, &[SIN_THETA, COS_THETA]) && has(more, &[SIN_THETA, COS_THETA]) {
         law.shapes.harmonic = more.shapes.harmonic;
     }
+    if !has(held, &[CURRENT_LIMIT]) && has(more, &[CURRENT_LIMIT]) {
+        law.shapes.current_limit = more.shapes.current_limit;
+    }
     law
 }
 
@@ -196,9 +244,11 @@ pub fn fit_named_terms<'a>(
     allowed: Option<&[String]>,
 ) -> Result<Option<Candidate>, Error> {
     let mut named: Vec<NamedTerm> = Vec::new();
-    for f in fingerprints {
-        if let Some(n) = named_term(problem, f)
-            && !named.iter().any(|m| m.same_term(&n))
+    for n in fingerprints
+        .into_iter()
+        .flat_map(|f| named_terms(problem, f))
+    {
+        if !named.iter().any(|m| m.same_term(&n))
             && allowed.is_none_or(|a| a.iter().any(|c| c == n.term.name()))
         {
             named.push(n);
@@ -255,6 +305,12 @@ pub struct Discovered {
     /// The angle's harmonic k (periods per revolution), where the law holds sin or cos(k·θ).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub k: Option<f64>,
+    /// The current limit I_lim [A], where the law holds `sign(I)*max(|I|-I_lim,0)`.
+    #[serde(rename = "I_lim", skip_serializing_if = "Option::is_none")]
+    pub current_limit: Option<f64>,
+    /// The frequency f [Hz] of a periodic law, where it holds sin or cos(2πft).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub frequency_hz: Option<f64>,
     /// The law as the report prints it, e.g. `J dω/dt += −0.0001·sign(ω)·|I| [95%: …]`.
     pub equation: String,
 }
@@ -289,10 +345,17 @@ pub fn discovered(fit: &Candidate, gained: f64) -> Option<Discovered> {
     let holds = |f: usize| functions.iter().any(|g| g.name == FUNCTIONS[f]);
     let omega_s = holds(STRIBECK).then_some(law.shapes.omega_s);
     let k = (holds(SIN_THETA) || holds(COS_THETA)).then_some(law.shapes.harmonic);
+    let frequency_hz = PERIODIC
+        .iter()
+        .any(|&p| holds(p))
+        .then_some(law.shapes.frequency);
+    let current_limit = holds(CURRENT_LIMIT).then_some(law.shapes.current_limit);
     let mut law = Discovered {
         equation: String::new(),
         omega_s,
         k,
+        current_limit,
+        frequency_hz,
         balance: BALANCES[balance].to_string(),
         functions,
         score: gained,
@@ -308,7 +371,12 @@ impl Discovered {
             .iter()
             .map(|f| (f.name.clone(), f.coefficient, Some((f.q025, f.q975))))
             .collect();
-        self.equation = with_harmonic(equation_with(&self.balance, &terms), self.k);
+        let equation = with_harmonic(equation_with(&self.balance, &terms), self.k);
+        let equation = match self.frequency_hz {
+            Some(f) => equation.replace("2πft", &format!("2π·{f:.2}·t")),
+            None => equation,
+        };
+        self.equation = with_limit(equation, self.current_limit);
     }
 
     /// The sampled fit's posterior mean and 95% interval in place of the Laplace ones, where
@@ -325,6 +393,14 @@ impl Discovered {
             }
         }
         self.write_equation();
+    }
+}
+
+/// An equation with the current limit written in: `max(|I|-212.4 A,0)` for I_lim = 212.4 A.
+fn with_limit(equation: String, limit: Option<f64>) -> String {
+    match limit {
+        Some(i) => equation.replace("I_lim", &format!("{i:.1} A")),
+        None => equation,
     }
 }
 

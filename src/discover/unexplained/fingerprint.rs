@@ -58,6 +58,10 @@ pub enum Fingerprint {
         /// they are among the functions.
         #[serde(rename = "k", skip_serializing_if = "Option::is_none")]
         harmonic: Option<f64>,
+        /// The current limit I_lim [A] of `sign(I)*max(|I|-I_lim,0)`, where it is one of the
+        /// functions.
+        #[serde(rename = "I_lim", skip_serializing_if = "Option::is_none")]
+        current_limit: Option<f64>,
         score: f64,
     },
     /// The balance drifts with time, the charge drawn or the heat dissipated: a state set of
@@ -172,14 +176,17 @@ impl Fingerprint {
                 balance,
                 functions,
                 harmonic,
+                current_limit,
                 ..
             } => format!(
                 "the {balance} balance follows the state: {} fits what is left (the term \
                  law); a record with another input would confirm the law beyond this one's \
                  states",
-                match harmonic {
-                    Some(k) => equation(balance, functions).replace("k·θ", &format!("{k}·θ")),
-                    None => equation(balance, functions),
+                match (harmonic, current_limit) {
+                    (Some(k), _) => equation(balance, functions).replace("k·θ", &format!("{k}·θ")),
+                    (_, Some(i)) =>
+                        equation(balance, functions).replace("I_lim", &format!("{i:.1} A")),
+                    _ => equation(balance, functions),
                 }
             ),
             Fingerprint::Drift {

@@ -17,7 +17,8 @@
 //! does, i.e. costs ln m nats); the threshold is the ranking's margin, for the ranking's
 //! reason. With N = 1002 and the 21 columns of the voltage balance (20 of the torque balance)
 //! the first column needs a gain of 3.45 + 3.04 + 2 = 8.49 nats: 21·P(χ²₁ > 17.0) ≈ 0.1% per
-//! balance on a null record. The
+//! balance on a null record (the current limit's six columns, in the voltage balance only,
+//! raise its bar by ln(27/21) = 0.25 nats). The
 //! fingerprint's score is
 //! the gain less the first two prices of each column taken (as the other alternatives' scores
 //! are their gain less ½·ln N per degree and the logarithm of their grid); the verdict's
@@ -32,14 +33,15 @@
 //! phase is between them may clear the bar that the two clear together, and the first step
 //! would go to whatever single function mimics the ripple's start. The periodic functions of
 //! time (frequency f a setting) are left to the oscillation alternative, which searches the
-//! frequency.
+//! frequency. The current limit I_lim of `sign(I)*max(|I|-I_lim,0)` is a shape too, searched
+//! over shares of the model's largest predicted current (a limit above it leaves no trace).
 
 use nalgebra::DMatrix;
 
 use crate::error::Error;
 use crate::forward::ForwardModel;
 use crate::motor::dictionary::{
-    self, COS_THETA, FUNCTIONS, N_FUNCTIONS, SIN_THETA, STRIBECK, Shapes,
+    self, COS_THETA, CURRENT_LIMIT, FUNCTIONS, N_FUNCTIONS, SIN_THETA, STRIBECK, Shapes,
 };
 use crate::motor::terms::Law;
 use crate::motor::{ActiveTerm, MotorModel, Term};
@@ -53,6 +55,10 @@ use super::{Context, Evidence, Fingerprint};
 /// The Stribeck speeds tried, as shares of the speed scale (no-load speed U/c_m): a hump a
 /// few hundredths of the way to full speed, as dry friction's is.
 const STRIBECK_SHARES: [f64; 6] = [0.004, 0.008, 0.016, 0.032, 0.064, 0.128];
+
+/// The current limits tried, as shares of the model's largest predicted |I|: a limit cuts the
+/// peak, by a little or by half.
+const CURRENT_LIMIT_SHARES: [f64; 6] = [0.5, 0.6, 0.7, 0.8, 0.9, 0.95];
 
 /// At most this many functions per balance: a law longer than that is no longer a fingerprint.
 const MAX_FUNCTIONS: usize = 4;
@@ -80,6 +86,7 @@ struct Column {
     function: usize,
     omega_s: Option<f64>,
     harmonic: Option<f64>,
+    current_limit: Option<f64>,
 }
 
 /// How a block of columns shapes the law it is evaluated on.
@@ -89,6 +96,7 @@ enum Shape {
     Own,
     StribeckSpeed(f64),
     Harmonic(f64),
+    CurrentLimit(f64),
 }
 
 /// The whitened sensitivities of the law's coefficients `keys` (parameter indices) at `fit`'s
@@ -128,6 +136,7 @@ fn law_columns(
         Shape::Own => {}
         Shape::StribeckSpeed(w) => shapes.omega_s = w,
         Shape::Harmonic(k) => shapes.harmonic = k,
+        Shape::CurrentLimit(i) => shapes.current_limit = i,
     }
     let mut shaped = law.clone().with_active(active);
     shaped.shapes = shapes;
@@ -211,8 +220,28 @@ pub(super) fn fingerprints(
                 .collect()
         }
     };
+    let current_limits: Vec<f64> = match &own {
+        Some(l) if holds(CURRENT_LIMIT) => vec![l.shapes.current_limit],
+        _ => {
+            let peak = ctx
+                .channels
+                .iter()
+                .position(|c| c == "I")
+                .map(|c| {
+                    ctx.fine.channels[c]
+                        .iter()
+                        .fold(0.0f64, |a, v| a.max(v.abs()))
+                })
+                .unwrap_or(0.0);
+            if peak > 0.0 {
+                CURRENT_LIMIT_SHARES.iter().map(|s| s * peak).collect()
+            } else {
+                Vec::new()
+            }
+        }
+    };
     let plain: Vec<usize> = (0..N_FUNCTIONS)
-        .filter(|&f| f != STRIBECK && f != SIN_THETA && f != COS_THETA)
+        .filter(|&f| f != STRIBECK && f != SIN_THETA && f != COS_THETA && f != CURRENT_LIMIT)
         .filter(|f| !dictionary::PERIODIC.contains(f))
         .collect();
     let mut columns: Vec<Column> = Vec::new();
@@ -234,6 +263,10 @@ pub(super) fn fingerprints(
                     Shape::Harmonic(k) => Some(k),
                     _ => None,
                 },
+                current_limit: match shape {
+                    Shape::CurrentLimit(i) => Some(i),
+                    _ => None,
+                },
             });
         }
         blocks.push((functions, b));
@@ -245,6 +278,9 @@ pub(super) fn fingerprints(
     }
     for k in harmonics {
         add(vec![SIN_THETA, COS_THETA], Shape::Harmonic(k))?;
+    }
+    for i in current_limits {
+        add(vec![CURRENT_LIMIT], Shape::CurrentLimit(i))?;
     }
     let mut out = Vec::new();
     for balance in 0..2 {
@@ -293,9 +329,11 @@ fn select(
         // One Stribeck speed and one harmonic at most: the law has one ω_s and one k.
         let stribeck = chosen.iter().find_map(|&j| columns[j].omega_s);
         let harmonic = chosen.iter().find_map(|&j| columns[j].harmonic);
+        let limit = chosen.iter().find_map(|&j| columns[j].current_limit);
         let open: Vec<usize> = (0..columns.len())
             .filter(|j| !chosen.contains(j))
             .filter(|&j| stribeck.is_none() || columns[j].omega_s.is_none())
+            .filter(|&j| limit.is_none() || columns[j].current_limit.is_none())
             .filter(|&j| {
                 harmonic.is_none() || columns[j].harmonic.is_none_or(|k| Some(k) == harmonic)
             })
@@ -371,6 +409,7 @@ fn select(
             functions,
             omega_s: chosen.iter().find_map(|&j| columns[j].omega_s),
             harmonic: chosen.iter().find_map(|&j| columns[j].harmonic),
+            current_limit: chosen.iter().find_map(|&j| columns[j].current_limit),
             score: score - shift,
         }
     };

@@ -105,6 +105,9 @@ impl PhysicsTerm for Law {
         15 "sin(2*pi*f*t)" "N·m" "V",
         16 "cos(2*pi*f*t)" "N·m" "V",
         17 "U*charge" "N·m/(V·A·s)" "1/(A·s)",
+        18 "omega*heat" "N·m·s/(rad·J)" "V·s/(rad·J)",
+        19 "I*heat" "N·m/(A·J)" "Ω/J",
+        20 "sign(I)*max(|I|-I_lim,0)" "N·m/A" "Ω",
     );
     const SETTINGS: &'static [TermSetting] = &[
         TermSetting {
@@ -135,6 +138,13 @@ impl PhysicsTerm for Law {
             speed_share: None,
             choices: &[],
         },
+        TermSetting {
+            key: "I_lim",
+            unit: "A",
+            default: 100.0,
+            speed_share: None,
+            choices: &[],
+        },
     ];
     const STATES: &'static [TermState] = &[
         TermState {
@@ -159,6 +169,7 @@ impl PhysicsTerm for Law {
                 omega_s: positive_setting(Self::NAME, "omega_s", s[1])?,
                 frequency: positive_setting(Self::NAME, "f", s[2])?,
                 harmonic: positive_setting(Self::NAME, "k", s[3])?,
+                current_limit: positive_setting(Self::NAME, "I_lim", s[4])?,
             },
         })
     }
@@ -169,6 +180,7 @@ impl PhysicsTerm for Law {
             self.shapes.omega_s,
             self.shapes.frequency,
             self.shapes.harmonic,
+            self.shapes.current_limit,
         ]
     }
 
