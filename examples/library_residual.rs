@@ -5,7 +5,11 @@
 //! nats, is printed. An effect a library term holds to within what the record can show leaves
 //! a few nats; one it stands in for leaves what the verdict should still find.
 //!
-//! cargo run --release --example library_residual -- CASE_DIR…
+//! With `--report NAME`, a column more: the miss left by the library terms a `diagnose --json`
+//! report (`CASE_DIR/NAME`) selected, fitted together (a `law` among them is left out), which
+//! says whether a selection of several terms holds what no single term does.
+//!
+//! cargo run --release --example library_residual -- [--report r.json] CASE_DIR…
 
 use std::path::Path;
 
@@ -16,19 +20,33 @@ use motorcal::study::cases::NOISE_SD;
 use motorcal::study::cases::oracle::least_squares;
 
 fn main() {
-    let dirs: Vec<String> = std::env::args().skip(1).collect();
+    let mut args: Vec<String> = std::env::args().skip(1).collect();
+    let report = args.iter().position(|a| a == "--report").map(|i| {
+        let name = args.get(i + 1).cloned().unwrap_or_default();
+        args.drain(i..(i + 2).min(args.len()));
+        name
+    });
+    let dirs = args;
     if dirs.is_empty() {
-        eprintln!("usage: library_residual CASE_DIR…");
+        eprintln!("usage: library_residual [--report NAME] CASE_DIR…");
         std::process::exit(2);
     }
+    let (extra, rule) = if report.is_some() {
+        (
+            " the report's library terms | the miss they leave |",
+            "---|---|",
+        )
+    } else {
+        ("", "")
+    };
     println!(
-        "| case | miss of the nominal model (nats) | best library term | miss it leaves (nats) | runner-up | its miss |"
+        "| case | miss of the nominal model (nats) | best library term | miss it leaves (nats) | runner-up | its miss |{extra}"
     );
-    println!("|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|{rule}");
     let mut failed = 0;
     for dir in dirs {
         let dir = Path::new(&dir);
-        match library_residual(dir) {
+        match library_residual(dir, report.as_deref()) {
             Ok(row) => println!("{row}"),
             Err(e) => {
                 eprintln!("{}: {e}", dir.display());
@@ -42,7 +60,7 @@ fn main() {
 }
 
 /// The table row of one case folder.
-fn library_residual(dir: &Path) -> Result<String, Error> {
+fn library_residual(dir: &Path, report: Option<&str>) -> Result<String, Error> {
     let problem = Problem::from_files(&[dir.join("truth.csv")], &dir.join("motor.toml"))?;
     let record = &problem.recordings[0];
     let mut target = Vec::new();
@@ -70,8 +88,28 @@ fn library_residual(dir: &Path) -> Result<String, Error> {
         ));
     };
     let name = dir.file_name().unwrap_or_default().to_string_lossy();
-    Ok(format!(
+    let mut row = format!(
         "| {name} | {none:.1} | {} | {:.1} | {} | {:.1} |",
         best.0, best.1, runner_up.0, runner_up.1
-    ))
+    );
+    if let Some(report) = report {
+        let path = dir.join(report);
+        let text = std::fs::read_to_string(&path)
+            .map_err(|e| Error::invalid(format!("{}: {e}", path.display())))?;
+        let json: serde_json::Value = serde_json::from_str(&text)
+            .map_err(|e| Error::invalid(format!("{}: {e}", path.display())))?;
+        let selected: Vec<String> = json["selected_set"]
+            .as_array()
+            .map(|a| {
+                a.iter()
+                    .filter_map(|v| v.as_str())
+                    .map(String::from)
+                    .collect()
+            })
+            .unwrap_or_default();
+        let library: Vec<String> = selected.into_iter().filter(|t| t != "law").collect();
+        let left = miss(&library)?;
+        row.push_str(&format!(" {} | {left:.1} |", library.join(" + ")));
+    }
+    Ok(row)
 }
