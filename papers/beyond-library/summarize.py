@@ -31,6 +31,9 @@ for c in sorted(os.listdir(d)):
         if k in ("delay", "lag"): return f"{k}{' on '+t['channel'] if k=='lag' else ''} {t['seconds']*1e3:.3f} ms"
         if k == "state": return f"state: {', '.join(t['functions'])}"
         return f"{k}: {t.get('variable','')}"
+    def law(x):
+        # The equation as the report prints it, its 95% intervals shortened.
+        return x["equation"].replace(" [95%: ", " [") if x else "—"
     kind_right = bool(fp_given) and fp_given["kind"] == truth["kind"]
     said_nothing = not u and not r["selected_set"]
     # The dynamic terms and the law are what a fingerprint names; any other selection with the
@@ -42,9 +45,9 @@ for c in sorted(os.listdir(d)):
     t = tally.setdefault(key, [0, 0, 0, 0, 0])
     t[0] += 1; t[1] += bool(u); t[2] += kind_right; t[3] += by_fingerprint; t[4] += library_alone
     rows.append(f"| {c} | {a['type']} | {a['miss_nats']:.0f} | {show_truth(truth)} | {' + '.join(r['selected_set']) or 'none'} | "
-                f"{'%+.1f' % u['evidence'] if u else 'null'} | {show(fp)} | {show(fp_given)} | {'nothing missing found' if said_nothing else ''} |")
-print("| case | type | miss (nats) | truth | selected | unexplained | fingerprint | fingerprint of the model as given | |")
-print("|---|---|---|---|---|---|---|---|---|")
+                f"{'%+.1f' % u['evidence'] if u else 'null'} | {show(fp)} | {show(fp_given)} | {law(r.get('discovered'))} | {'nothing missing found' if said_nothing else ''} |")
+print("| case | type | miss (nats) | truth | selected | unexplained | fingerprint | fingerprint of the model as given | discovered law | |")
+print("|---|---|---|---|---|---|---|---|---|---|")
 print("\n".join(rows))
 print()
 print("| effect | cases | unexplained not null after | the model as given's fingerprint of the right kind | a dynamic term or law selected | a library term alone, verdict null |")
