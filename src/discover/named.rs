@@ -28,7 +28,9 @@ use crate::study::Problem;
 
 use super::candidate::{Candidate, Starts, fit_candidate_started};
 use super::settings::EVIDENCE_THRESHOLD;
-use super::unexplained::{EquationTerm, Fingerprint, equation_with, frequency_search_cost};
+use super::unexplained::{
+    EquationTerm, Fingerprint, equation_with, frequency_search_cost, with_shapes,
+};
 
 /// The term a fingerprint names, with its settings and the parameter values it starts at.
 #[derive(Clone, Debug, PartialEq)]
@@ -371,12 +373,12 @@ impl Discovered {
             .iter()
             .map(|f| (f.name.clone(), f.coefficient, Some((f.q025, f.q975))))
             .collect();
-        let equation = with_harmonic(equation_with(&self.balance, &terms), self.k);
-        let equation = match self.frequency_hz {
-            Some(f) => equation.replace("2πft", &format!("2π·{f:.2}·t")),
-            None => equation,
-        };
-        self.equation = with_limit(equation, self.current_limit);
+        self.equation = with_shapes(
+            equation_with(&self.balance, &terms),
+            self.k,
+            self.current_limit,
+            self.frequency_hz,
+        );
     }
 
     /// The sampled fit's posterior mean and 95% interval in place of the Laplace ones, where
@@ -393,21 +395,5 @@ impl Discovered {
             }
         }
         self.write_equation();
-    }
-}
-
-/// An equation with the current limit written in: `max(|I|-212.4 A,0)` for I_lim = 212.4 A.
-fn with_limit(equation: String, limit: Option<f64>) -> String {
-    match limit {
-        Some(i) => equation.replace("I_lim", &format!("{i:.1} A")),
-        None => equation,
-    }
-}
-
-/// An equation with the angle's harmonic written in: `sin(6·θ)` for `sin(k·θ)` at k = 6.
-fn with_harmonic(equation: String, k: Option<f64>) -> String {
-    match k {
-        Some(k) => equation.replace("k·θ", &format!("{k}·θ")),
-        None => equation,
     }
 }

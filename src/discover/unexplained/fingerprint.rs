@@ -182,12 +182,12 @@ impl Fingerprint {
                 "the {balance} balance follows the state: {} fits what is left (the term \
                  law); a record with another input would confirm the law beyond this one's \
                  states",
-                match (harmonic, current_limit) {
-                    (Some(k), _) => equation(balance, functions).replace("k·θ", &format!("{k}·θ")),
-                    (_, Some(i)) =>
-                        equation(balance, functions).replace("I_lim", &format!("{i:.1} A")),
-                    _ => equation(balance, functions),
-                }
+                with_shapes(
+                    equation(balance, functions),
+                    *harmonic,
+                    *current_limit,
+                    None
+                )
             ),
             Fingerprint::Drift {
                 variable,
@@ -215,6 +215,27 @@ pub type EquationTerm = (String, f64, Option<(f64, f64)>);
 
 /// A balance's law as an equation, e.g. `J dω/dt += −0.012·sign(ω)·|I|`, each function with
 /// its coefficient and, where given, an interval after it.
+/// A law's shapes written into its equation: `sin(6·θ)` for `sin(k·θ)` at k = 6,
+/// `max(|I|-212.4 A,0)` for I_lim = 212.4 A, `sin(2π·105.36·t)` for `sin(2πft)` at f = 105.36 Hz.
+pub fn with_shapes(
+    equation: String,
+    harmonic: Option<f64>,
+    current_limit: Option<f64>,
+    frequency_hz: Option<f64>,
+) -> String {
+    let mut equation = equation;
+    if let Some(k) = harmonic {
+        equation = equation.replace("k·θ", &format!("{k}·θ"));
+    }
+    if let Some(i) = current_limit {
+        equation = equation.replace("I_lim", &format!("{i:.1} A"));
+    }
+    if let Some(f) = frequency_hz {
+        equation = equation.replace("2πft", &format!("2π·{f:.2}·t"));
+    }
+    equation
+}
+
 pub fn equation_with(balance: &str, terms: &[EquationTerm]) -> String {
     let lhs = if balance == "voltage" {
         "L dI/dt"

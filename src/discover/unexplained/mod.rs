@@ -48,7 +48,7 @@ use super::coincide::input_steps;
 use super::fits::MISMATCH_MIN_SHARE;
 use super::settings::EVIDENCE_THRESHOLD;
 pub use as_given::AsGiven;
-pub use fingerprint::{EquationTerm, Fingerprint, equation_with};
+pub use fingerprint::{EquationTerm, Fingerprint, equation_with, with_shapes};
 use oscillation::Oscillation;
 pub use oscillation::{frequency_search_cost, lowest_frequency_over};
 use regression::{Explained, Projector, explain};
