@@ -146,6 +146,73 @@ fn a_recording_of_the_model_itself_leaves_nothing_unexplained() {
     }
 }
 
+/// An inductance that falls with the current (the iron saturating, from the second set of
+/// effects not built for: `beyond_library_cases --effects
+/// inductance_saturation,return_spring,load_ripple --per-effect 4 --seed-base 570000`): the
+/// current rises faster than the model's after each input step, a few samples at a time, and
+/// the noise-free truth misses the best nominal model by 37.8 nats. No polynomial, sinusoid or
+/// lag holds a transient that leads; the channel's derivative with a lead's sign does, so the
+/// verdict says something is left on I and what it looks like, not "nothing missing".
+#[test]
+fn a_current_that_runs_ahead_of_the_model_is_not_nothing_missing() {
+    let (problem, answer) = fixture("inductance_saturation-570010");
+    assert!(answer["miss_nats"].as_f64().unwrap() >= 30.0);
+    let mut s = settings();
+    s.candidates = None;
+    let d = discover(&problem, &s).unwrap();
+    assert!(d.residual_mismatch);
+    let u = d
+        .unexplained
+        .expect("a 38-nat miss is not 'nothing missing'");
+    assert!(
+        matches!(u.fingerprint, Fingerprint::Unknown { .. }),
+        "{:?}",
+        u.fingerprint
+    );
+    assert_eq!(u.channels, ["I"]);
+    assert!(u.suggestion.contains("runs ahead"), "{}", u.suggestion);
+}
+
+/// A leakage path on the supply side of the current sensor (`beyond_library_cases --effects
+/// leakage_current,tacho_nonlinearity,backlash --per-effect 4 --seed-base 580000`): what is
+/// read is I + g·U, the motor itself untouched. On the model as given the fingerprint is a law
+/// of what is read, not of a balance: the measured current follows the input, with the
+/// leak's conductance within three sds of the truth.
+#[test]
+fn a_current_sensor_that_also_reads_the_input_is_fingerprinted_as_a_measurement() {
+    let (problem, answer) = fixture("leakage_current-580010");
+    let truth = answer["truth"].as_str().unwrap();
+    let g: f64 = truth
+        .trim_start_matches("LeakageCurrent { g: ")
+        .trim_end_matches(" }")
+        .parse()
+        .unwrap();
+    let mut s = settings();
+    s.candidates = None;
+    let d = discover(&problem, &s).unwrap();
+    let u = d
+        .unexplained_as_given
+        .expect("a leak 147 nats strong shows");
+    match &u.fingerprint {
+        Fingerprint::State {
+            balance, functions, ..
+        } => {
+            assert_eq!(balance, "measurement:I");
+            assert_eq!(functions.len(), 1, "{functions:?}");
+            assert_eq!(functions[0].name, "U");
+            let f = &functions[0];
+            assert!(
+                (f.coefficient - g).abs() < 3.0 * f.sd,
+                "{} ± {} S vs {g}",
+                f.coefficient,
+                f.sd
+            );
+        }
+        other => panic!("expected a law of what is read, found {other:?}"),
+    }
+    assert!(u.suggestion.contains("measured I +="), "{}", u.suggestion);
+}
+
 /// With the whole library (the dynamic terms included, as `diagnose` runs by default) the
 /// dynamic term is ranked from the verdict's estimate on the model as given (its start), taken
 /// by the ranking's threshold, its parameter lands within 30% of the truth, and nothing is left;

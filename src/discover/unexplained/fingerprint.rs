@@ -46,7 +46,9 @@ pub enum Fingerprint {
         sd: f64,
         score: f64,
     },
-    /// The balance (`torque`, `voltage`) misses a sum of dictionary functions of the state.
+    /// The balance (`torque`, `voltage`) misses a sum of dictionary functions of the state, or
+    /// what is read of a channel does (`measurement:I`, `measurement:omega`: told, not fitted;
+    /// no law term holds a measurement yet).
     State {
         balance: String,
         functions: Vec<LawFunction>,
@@ -173,6 +175,19 @@ impl Fingerprint {
                 seconds * 1e3
             ),
             Fingerprint::State {
+                balance, functions, ..
+            }
+            | Fingerprint::Drift {
+                balance, functions, ..
+            } if balance.starts_with("measurement:") => format!(
+                "what is read of {} follows the state: {} fits what is left — a sensor that \
+                 also reads the input or the other channel (crosstalk; a leakage path on the \
+                 supply side of a current sensor), reads nonlinearly or drifts; no law term \
+                 holds a measurement yet",
+                balance.trim_start_matches("measurement:"),
+                equation(balance, functions)
+            ),
+            Fingerprint::State {
                 balance,
                 functions,
                 harmonic,
@@ -237,10 +252,11 @@ pub fn with_shapes(
 }
 
 pub fn equation_with(balance: &str, terms: &[EquationTerm]) -> String {
-    let lhs = if balance == "voltage" {
-        "L dI/dt"
-    } else {
-        "J dω/dt"
+    let lhs = match balance {
+        "voltage" => "L dI/dt",
+        "measurement:I" => "measured I",
+        "measurement:omega" => "measured ω",
+        _ => "J dω/dt",
     };
     let mut text = format!("{lhs} +=");
     for (i, (name, c, interval)) in terms.iter().enumerate() {

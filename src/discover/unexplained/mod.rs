@@ -6,7 +6,10 @@
 //! samples), an autoregression of the residual (p = 1, 2, 4, 8), a sinusoid through the record
 //! and a damped sinusoid ringing after each input step (`oscillation`), every channel late by
 //! τ (an input delay), one channel filtered with time constant τ (a sensor lag) and with a
-//! second-order filter that rings (a resonant sensor, `resonance`). Each is
+//! second-order filter that rings (a resonant sensor, `resonance`), a channel that runs ahead
+//! of the model (its derivative with a lead's sign: generic, no sensor leads, but a balance
+//! whose fast dynamics the model has too slow looks so), and the state fingerprints of the
+//! balances and of what is read (`state`). Each is
 //! scored as the ranking scores a term: its linearised gain in log likelihood with the model's
 //! parameters refitted beside it (`regression`), less ½·ln N per degree of freedom, less the
 //! logarithm of the grid a search ran over. The same alternatives are scored on the model as
@@ -31,6 +34,7 @@ mod fingerprint;
 mod oscillation;
 mod regression;
 mod resonance;
+mod spans;
 mod starts;
 mod state;
 mod step_screen;
@@ -45,13 +49,14 @@ use crate::study::Problem;
 
 use super::candidate::Candidate;
 use super::coincide::input_steps;
-use super::fits::MISMATCH_MIN_SHARE;
 use super::settings::EVIDENCE_THRESHOLD;
 pub use as_given::AsGiven;
 pub use fingerprint::{EquationTerm, Fingerprint, equation_with, with_shapes};
 use oscillation::Oscillation;
 pub use oscillation::{frequency_search_cost, lowest_frequency_over};
 use regression::{Explained, Projector, explain};
+pub use spans::Span;
+use spans::spans;
 pub use starts::{DYNAMIC, dynamic_starts};
 pub use step_screen::StepScreen;
 use timing::FinePrediction;
@@ -230,15 +235,9 @@ impl Context {
 struct Generic {
     channel: usize,
     polynomial: bool,
+    /// The channel's derivative with a lead's sign: the channel runs ahead of the model.
+    lead: bool,
     scored: Scored,
-}
-
-/// Where the best polynomial of a channel departs from zero by more than two of its sds.
-#[derive(Clone, Debug, Serialize)]
-pub struct Span {
-    pub channel: String,
-    pub t_start: f64,
-    pub t_end: f64,
 }
 
 /// The verdict's report: `null` in the JSON when nothing is left.
@@ -319,6 +318,7 @@ fn scores(ctx: &Context, shift: f64) -> Scores {
             generic.push(Generic {
                 channel: c,
                 polynomial: true,
+                lead: false,
                 scored: ctx.score(&b, 0.0),
             });
         }
@@ -333,6 +333,7 @@ fn scores(ctx: &Context, shift: f64) -> Scores {
             generic.push(Generic {
                 channel: c,
                 polynomial: false,
+                lead: false,
                 scored: ctx.score(&ctx.in_channel(c, &lags), 0.0),
             });
         }
@@ -347,6 +348,17 @@ fn scores(ctx: &Context, shift: f64) -> Scores {
         let d = DMatrix::from_column_slice(n, 1, &ctx.derivative(c));
         let s = ctx.score(&ctx.in_channel(c, &d), 0.0);
         let mut lag = None;
+        if s.explained.coefficients[0] > 0.0 {
+            // The channel runs ahead of the model: no sensor leads, but a balance whose fast
+            // dynamics the model has too slow (an inductance too large) looks like this. Generic:
+            // it says something is left, not what.
+            generic.push(Generic {
+                channel: c,
+                polynomial: false,
+                lead: true,
+                scored: s.clone(),
+            });
+        }
         if s.explained.coefficients[0] < 0.0
             && let Some(t) = timing::fit(ctx, &ctx.fine, Some(c), -s.explained.coefficients[0])
         {
@@ -407,37 +419,6 @@ fn oscillation_fingerprint(o: &Oscillation, channel: &str, shift: f64) -> Finger
         score: o.scored.score - shift,
         frequencies: o.frequencies,
     }
-}
-
-/// Samples where a fitted curve departs from zero by more than two of its sds, as intervals of
-/// at least `MISMATCH_MIN_SHARE` of the record.
-fn spans(ctx: &Context, c: usize, e: &Explained) -> Vec<Span> {
-    let n = ctx.n;
-    let duration = ctx.times[n - 1] - ctx.times[0];
-    let mut out = Vec::new();
-    let mut start: Option<usize> = None;
-    for i in 0..=n {
-        let off = i < n && {
-            let k = c * n + i;
-            e.fitted[k].abs() > 2.0 * e.fitted_sd[k]
-        };
-        match (off, start) {
-            (true, None) => start = Some(i),
-            (false, Some(s)) => {
-                let (a, b) = (ctx.times[s], ctx.times[i - 1]);
-                if b - a >= MISMATCH_MIN_SHARE * duration {
-                    out.push(Span {
-                        channel: ctx.channels[c].clone(),
-                        t_start: a,
-                        t_end: b,
-                    });
-                }
-                start = None;
-            }
-            _ => {}
-        }
-    }
-    out
 }
 
 /// The verdict on the first record: `None` when the selected model leaves nothing a generic
@@ -569,7 +550,18 @@ pub fn unexplained(
     if channels.is_empty() {
         channels = ctx.channels.clone();
     }
-    let suggestion = fingerprint.suggestion(&channels);
+    let mut suggestion = fingerprint.suggestion(&channels);
+    if let (Fingerprint::Unknown { .. }, Some(g)) = (&fingerprint, best_generic)
+        && g.lead
+    {
+        suggestion = format!(
+            "{} runs ahead of the model where it changes fast, as if that balance's fast \
+             dynamics were quicker than the model's (in the voltage balance: an inductance \
+             smaller than L, or one that falls with the current); steps of several sizes would \
+             tell a constant from a current-dependent one",
+            ctx.channels[g.channel]
+        );
+    }
     Ok(Some(Unexplained {
         evidence,
         channels,

@@ -41,7 +41,7 @@ use nalgebra::DMatrix;
 use crate::error::Error;
 use crate::forward::ForwardModel;
 use crate::motor::dictionary::{
-    self, COS_THETA, CURRENT_LIMIT, FUNCTIONS, N_FUNCTIONS, SIN_THETA, STRIBECK, Shapes,
+    self, COS_THETA, CURRENT_LIMIT, FUNCTIONS, N_FUNCTIONS, Point, SIN_THETA, STRIBECK, Shapes,
 };
 use crate::motor::terms::Law;
 use crate::motor::{ActiveTerm, MotorModel, Term};
@@ -79,6 +79,14 @@ const HARMONICS: [f64; 7] = [1.0, 2.0, 3.0, 4.0, 6.0, 8.0, 12.0];
 fn sampled_ripple(k: f64, speed: f64, interval: f64) -> bool {
     k * speed * interval < std::f64::consts::PI
 }
+
+/// The functions a measured channel is offered in (`measurement:I`, `measurement:omega`): a
+/// sensor that reads the input or the other channel besides its own (crosstalk; a leakage path
+/// on the supply side of a current sensor reads I + U/R_p), one that reads nonlinearly, one
+/// that drifts. The speed's own linear gain is the library's `speed_gain`, not offered on ω.
+/// With seven columns the first needs ½·ln N + ln 7 + 2 = 7.4 nats at N = 1002: as the
+/// balances' selection reasons, about 7·P(χ²₁ > 14.9) ≈ 0.1% per channel on a null record.
+const MEASURED: [usize; 7] = [0, 1, 2, 5, 7, 9, 12];
 
 /// A column of the regression: a function (dictionary index) and the shape it has, the
 /// Stribeck speed or the angle's harmonic.
@@ -294,7 +302,9 @@ pub(super) fn fingerprints(
             }
         }
         let b_tilde = ctx.projector.residualize(&b);
-        let first = select(ctx, &columns, &b_tilde, balance, shift, |_| true);
+        let name = dictionary::BALANCES[balance];
+        let offered = |f: usize| dictionary::offered_in(f, balance);
+        let first = select(ctx, &columns, &b_tilde, name, shift, offered);
         // A ripple in the angle on its own as well, where the selection took another
         // function first: on a record that spins up from rest the ripple's net early push is
         // what a Stribeck hump also gives, and to first order the two are near; the fits
@@ -306,11 +316,68 @@ pub(super) fn fingerprints(
         let add_ripple = first.as_ref().is_some_and(|e| !took_angle(e));
         out.extend(first);
         if add_ripple {
-            let angle = |f: usize| f == SIN_THETA || f == COS_THETA;
-            out.extend(select(ctx, &columns, &b_tilde, balance, shift, angle));
+            let angle = |f: usize| (f == SIN_THETA || f == COS_THETA) && offered(f);
+            out.extend(select(ctx, &columns, &b_tilde, name, shift, angle));
         }
     }
+    out.extend(measurement_fingerprints(fit, ctx, shift));
     Ok(out)
+}
+
+/// The state fingerprints of the measured channels: the residual of a channel regressed on
+/// functions of the predicted state and the input in that channel alone (a measurement adds
+/// to what is read, not to a balance: the column is the function itself, no solve needed),
+/// selected as a balance's are. No law term holds a measurement yet, so these are told, not
+/// fitted.
+fn measurement_fingerprints(fit: &Candidate, ctx: &Context, shift: f64) -> Vec<Evidence> {
+    let model = fit.posterior.forward(0).model();
+    // The functions offered read no shape; the dictionary's defaults stand.
+    let Some(Term::Law(law)) = Term::named("law") else {
+        return Vec::new();
+    };
+    let index = |name: &str| ctx.channels.iter().position(|c| c == name);
+    let (current, speed) = (index("I"), index("omega"));
+    let mut out = Vec::new();
+    for (c, channel) in ctx.channels.iter().enumerate() {
+        if Some(c) != current && Some(c) != speed {
+            continue;
+        }
+        let functions: Vec<usize> = MEASURED
+            .into_iter()
+            .filter(|&f| !(Some(c) == speed && f == 0))
+            .filter(|&f| speed.is_some() || f > 2)
+            .filter(|&f| current.is_some() || !(f == 5 || f == 7))
+            .collect();
+        let mut b = DMatrix::zeros(ctx.m(), functions.len());
+        for i in 0..ctx.n {
+            let t = ctx.times[i];
+            let x = Point {
+                t,
+                current: current.map_or(0.0, |k| ctx.fine.at(k, t)),
+                speed: speed.map_or(0.0, |k| ctx.fine.at(k, t)),
+                voltage: model.input.value_at(t).unwrap_or(model.nominal.voltage),
+                charge: 0.0,
+                heat: 0.0,
+                theta: 0.0,
+            };
+            for (j, &f) in functions.iter().enumerate() {
+                b[(c * ctx.n + i, j)] = dictionary::value(f, &x, &law.shapes) / ctx.sigma[c];
+            }
+        }
+        let columns: Vec<Column> = functions
+            .iter()
+            .map(|&function| Column {
+                function,
+                omega_s: None,
+                harmonic: None,
+                current_limit: None,
+            })
+            .collect();
+        let b_tilde = ctx.projector.residualize(&b);
+        let balance = format!("measurement:{channel}");
+        out.extend(select(ctx, &columns, &b_tilde, &balance, shift, |_| true));
+    }
+    out
 }
 
 /// Forward selection of one balance's columns (see the module's doc), and the fingerprint it
@@ -319,7 +386,7 @@ fn select(
     ctx: &Context,
     columns: &[Column],
     b_tilde: &DMatrix<f64>,
-    balance: usize,
+    balance: &str,
     shift: f64,
     offered: impl Fn(usize) -> bool,
 ) -> Option<Evidence> {
@@ -337,7 +404,6 @@ fn select(
             .filter(|&j| {
                 harmonic.is_none() || columns[j].harmonic.is_none_or(|k| Some(k) == harmonic)
             })
-            .filter(|&j| dictionary::offered_in(columns[j].function, balance))
             .filter(|&j| offered(columns[j].function))
             .collect();
         // The moves: each open column, and each harmonic's sin and cos together.
@@ -389,7 +455,7 @@ fn select(
             sd: sds[i],
         })
         .collect();
-    let balance = dictionary::BALANCES[balance].to_string();
+    let balance = balance.to_string();
     let drift = |f: &LawFunction| match f.name.as_str() {
         "t" => Some("time"),
         "charge" | "U*charge" => Some("charge"),

@@ -52,7 +52,7 @@ impl FinePrediction {
         Ok(Self { times, channels })
     }
 
-    fn at(&self, c: usize, t: f64) -> f64 {
+    pub(super) fn at(&self, c: usize, t: f64) -> f64 {
         self.read(&self.channels[c], t)
     }
 

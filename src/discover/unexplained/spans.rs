@@ -1,0 +1,47 @@
+//! Where a channel's residual departs from zero: the report's `where`, from the best
+//! polynomial of each channel that clears the threshold.
+
+use serde::Serialize;
+
+use super::Context;
+use super::regression::Explained;
+use crate::discover::fits::MISMATCH_MIN_SHARE;
+
+/// Where the best polynomial of a channel departs from zero by more than two of its sds.
+#[derive(Clone, Debug, Serialize)]
+pub struct Span {
+    pub channel: String,
+    pub t_start: f64,
+    pub t_end: f64,
+}
+
+/// Samples where a fitted curve departs from zero by more than two of its sds, as intervals of
+/// at least `MISMATCH_MIN_SHARE` of the record.
+pub(super) fn spans(ctx: &Context, c: usize, e: &Explained) -> Vec<Span> {
+    let n = ctx.n;
+    let duration = ctx.times[n - 1] - ctx.times[0];
+    let mut out = Vec::new();
+    let mut start: Option<usize> = None;
+    for i in 0..=n {
+        let off = i < n && {
+            let k = c * n + i;
+            e.fitted[k].abs() > 2.0 * e.fitted_sd[k]
+        };
+        match (off, start) {
+            (true, None) => start = Some(i),
+            (false, Some(s)) => {
+                let (a, b) = (ctx.times[s], ctx.times[i - 1]);
+                if b - a >= MISMATCH_MIN_SHARE * duration {
+                    out.push(Span {
+                        channel: ctx.channels[c].clone(),
+                        t_start: a,
+                        t_end: b,
+                    });
+                }
+                start = None;
+            }
+            _ => {}
+        }
+    }
+    out
+}
