@@ -14,7 +14,9 @@
 //!
 //! Beside the default nine, effects no detector here was built around, kept out of the default
 //! set so that its seeds keep their cases: `cogging`, and `flux_saturation`, `thermal_magnet`,
-//! `current_limit`, `supply_ripple` (a stand-in for the private holdout's effects not named).
+//! `current_limit`, `supply_ripple` (a stand-in for the private holdout's effects not named),
+//! and a second such set made after the first was worked on: `inductance_saturation`,
+//! `return_spring`, `load_ripple`; then `leakage_current`, `tacho_nonlinearity`, `backlash`.
 //!
 //! cargo run --release --example beyond_library_cases -- [--out DIR] [--per-effect 3]
 //!     [--seed-base 510000] [--min-nats 20] [--max-nats 300] [--effects a,b,…] [--volts 24]
@@ -88,6 +90,24 @@ enum Effect {
     CurrentLimit { i_max: f64 },
     /// A rectified supply's ripple: U·(1 + ε·cos 2πft). `--effects supply_ripple`.
     SupplyRipple { eps: f64, f: f64 },
+    /// The winding's inductance falling as its iron saturates: L/(1 + |I|/I_L) in the voltage
+    /// balance's L·dI/dt. `--effects inductance_saturation`.
+    InductanceSaturation { i_l: f64 },
+    /// A return spring on the shaft (a throttle or valve actuator): a torque −k·θ, θ = ∫ω.
+    /// `--effects return_spring`.
+    ReturnSpring { k: f64 },
+    /// A misaligned coupling passing the torque unevenly, k times per revolution: a share
+    /// ε·sin(kθ + φ) of the motor's torque c_g·I lost. `--effects load_ripple`.
+    LoadRipple { eps: f64, k: u32, phase: f64 },
+    /// A leakage path beside the winding, on the supply side of the current sensor: the
+    /// measured current is I + U·g. `--effects leakage_current`.
+    LeakageCurrent { g: f64 },
+    /// A tachometer whose gain rises with the speed: ω measured as ω + a·ω·|ω|.
+    /// `--effects tacho_nonlinearity`.
+    TachoNonlinearity { a: f64 },
+    /// A gearbox's backlash: the load (share s of the inertia) on a stiff shaft (300 Hz,
+    /// ζ 0.1) that transmits nothing while the twist is inside ±b rad. `--effects backlash`.
+    Backlash { share: f64, gap: f64 },
 }
 
 impl Effect {
@@ -145,6 +165,19 @@ impl Effect {
                 eps: 1e-2,
                 f: rng.random_range(50.0..150.0),
             },
+            "inductance_saturation" => Effect::InductanceSaturation { i_l: 1e3 },
+            "return_spring" => Effect::ReturnSpring { k: 1e-6 },
+            "load_ripple" => Effect::LoadRipple {
+                eps: 1e-2,
+                k: rng.random_range(1..=2u32),
+                phase: rng.random_range(0.0..2.0 * PI),
+            },
+            "leakage_current" => Effect::LeakageCurrent { g: 1e-2 },
+            "tacho_nonlinearity" => Effect::TachoNonlinearity { a: 1e-5 },
+            "backlash" => Effect::Backlash {
+                share: rng.random_range(0.3..0.7),
+                gap: 1e-2,
+            },
             other => panic!("unknown effect {other}; known: {:?}", Effect::NAMES),
         }
     }
@@ -166,6 +199,12 @@ impl Effect {
             Effect::ThermalMagnet { beta } => beta,
             Effect::CurrentLimit { i_max } => 1.0 / i_max,
             Effect::SupplyRipple { eps, .. } => eps,
+            Effect::InductanceSaturation { i_l } => 1.0 / i_l,
+            Effect::ReturnSpring { k } => k,
+            Effect::LoadRipple { eps, .. } => eps,
+            Effect::LeakageCurrent { g } => g,
+            Effect::TachoNonlinearity { a } => a,
+            Effect::Backlash { gap, .. } => gap,
         }
     }
 
@@ -185,6 +224,12 @@ impl Effect {
             Effect::ThermalMagnet { beta } => *beta = s,
             Effect::CurrentLimit { i_max } => *i_max = 1.0 / s,
             Effect::SupplyRipple { eps, .. } => *eps = s,
+            Effect::InductanceSaturation { i_l } => *i_l = 1.0 / s,
+            Effect::ReturnSpring { k } => *k = s,
+            Effect::LoadRipple { eps, .. } => *eps = s,
+            Effect::LeakageCurrent { g } => *g = s,
+            Effect::TachoNonlinearity { a } => *a = s,
+            Effect::Backlash { gap, .. } => *gap = s,
         }
         e
     }
@@ -199,6 +244,12 @@ impl Effect {
             // A limit of 10 A; a ripple of half the supply.
             Effect::CurrentLimit { .. } => 0.1,
             Effect::SupplyRipple { .. } => 0.5,
+            // An inductance at most a tenth of its own at 10 A; a ripple of half the torque.
+            Effect::InductanceSaturation { .. } => 0.1,
+            Effect::LoadRipple { .. } => 0.5,
+            // A leak of at most 10 Ω; a gap of at most half a radian.
+            Effect::LeakageCurrent { .. } => 0.1,
+            Effect::Backlash { .. } => 0.5,
             _ => 1.0,
         }
     }
@@ -244,6 +295,7 @@ fn rhs(
     let mut motor_inertia = m.j;
     // The flux, as a share of the nominal: it scales the torque and the back-EMF alike.
     let mut flux = 1.0;
+    let mut inductance = m.l;
     match e {
         Some(&Effect::Stribeck { t_c, omega_s }) => {
             torque -= (t_c + 2.0 * t_c * (-(w / omega_s).powi(2)).exp()) * w.tanh();
@@ -293,15 +345,45 @@ fn rhs(
             u -= 1.0 * (i.abs() - i_max).max(0.0) * i.signum();
         }
         Some(&Effect::SupplyRipple { eps, f }) => u *= 1.0 + eps * (2.0 * PI * f * t).cos(),
-        None => {}
+        Some(&Effect::InductanceSaturation { i_l }) => inductance = m.l / (1.0 + i.abs() / i_l),
+        Some(&Effect::ReturnSpring { k }) => {
+            torque -= k * x[2];
+            dx[2] = w;
+        }
+        Some(&Effect::Backlash { share, gap }) => {
+            let (jm, jl) = ((1.0 - share) * m.j, share * m.j);
+            let wr = 2.0 * PI * 300.0;
+            let k = wr * wr / (1.0 / jm + 1.0 / jl);
+            let c = 2.0 * 0.1 * wr / (1.0 / jm + 1.0 / jl);
+            let twist = x[2];
+            let engaged = twist.abs() > gap;
+            let coupling = if engaged {
+                k * (twist - gap * twist.signum()) + c * (w - x[3])
+            } else {
+                0.0
+            };
+            torque -= coupling;
+            motor_inertia = jm;
+            dx[2] = w - x[3];
+            dx[3] = (coupling - m.d * x[3]) / jl;
+        }
+        Some(&Effect::LoadRipple { eps, k, phase }) => {
+            torque -= eps * m.c_g * i * (k as f64 * x[2] + phase).sin();
+            dx[2] = w;
+        }
+        // These act on what is measured (`measured`, `simulate`), not on the motor.
+        Some(Effect::LeakageCurrent { .. } | Effect::TachoNonlinearity { .. }) | None => {}
     }
     // With a coupling, the viscous loss acts on the load side.
-    let d_motor = if matches!(e, Some(Effect::CompliantCoupling { .. })) {
+    let d_motor = if matches!(
+        e,
+        Some(Effect::CompliantCoupling { .. } | Effect::Backlash { .. })
+    ) {
         0.0
     } else {
         m.d
     };
-    dx[0] = (u - m.r * i - flux * m.c_m * w) / m.l;
+    dx[0] = (u - m.r * i - flux * m.c_m * w) / inductance;
     dx[1] = (flux * m.c_g * i - d_motor * w + torque) / motor_inertia;
     dx
 }
@@ -311,6 +393,7 @@ fn measured(e: Option<&Effect>, x: &[f64; 4]) -> [f64; 2] {
         Some(Effect::ResonantSensor { .. }) => [x[0], x[2]],
         Some(&Effect::SensorLag { channel: 0, .. }) => [x[2], x[1]],
         Some(&Effect::SensorLag { .. }) => [x[0], x[2]],
+        Some(&Effect::TachoNonlinearity { a }) => [x[0], x[1] + a * x[1] * x[1].abs()],
         _ => [x[0], x[1]],
     }
 }
@@ -334,7 +417,11 @@ fn simulate(m: &Motor, e: Option<&Effect>, input: &Input, times: &[f64]) -> Vec<
             });
             t += h;
         }
-        out.push(measured(e, &x));
+        let mut y = measured(e, &x);
+        if let Some(&Effect::LeakageCurrent { g }) = e {
+            y[0] += g * input.at(t, times);
+        }
+        out.push(y);
     }
     out
 }
@@ -420,6 +507,15 @@ fn expected(e: &Effect) -> String {
         Effect::ThermalMagnet { .. } => r#"{"kind": "drift", "variable": "heat"}"#.into(),
         Effect::CurrentLimit { .. } => r#"{"kind": "state", "balance": "voltage", "functions": ["I", "|I|", "I*|I|"]}"#.into(),
         Effect::SupplyRipple { f, .. } => format!(r#"{{"kind": "oscillation", "frequency_hz": {f}, "ringing": false}}"#),
+        // dI/dt is in no dictionary: the tool should say something is left, not what.
+        Effect::InductanceSaturation { .. } => r#"{"kind": "unknown"}"#.into(),
+        // θ itself is in no dictionary; on a record that turns one way it grows like the time.
+        Effect::ReturnSpring { .. } => r#"{"kind": "drift", "variable": "time"}"#.into(),
+        Effect::LeakageCurrent { .. } => r#"{"kind": "state", "balance": "measurement:I", "functions": ["U"]}"#.into(),
+        Effect::TachoNonlinearity { .. } => r#"{"kind": "state", "balance": "measurement:omega", "functions": ["omega*|omega|"]}"#.into(),
+        // The load's impact as the gap closes rings the shaft.
+        Effect::Backlash { .. } => r#"{"kind": "oscillation", "channel": "omega", "ringing": true}"#.into(),
+        Effect::LoadRipple { k, .. } => format!(r#"{{"kind": "state", "balance": "torque", "functions": ["sin(k*theta)", "cos(k*theta)"], "k": {k}}}"#),
     }
 }
 

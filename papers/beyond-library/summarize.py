@@ -27,9 +27,11 @@ for c in sorted(os.listdir(d)):
         return k
     def show_truth(t):
         k = t["kind"]
-        if k == "oscillation": return f"oscillation {t['frequency_hz']:.1f} Hz ({'rings' if t['ringing'] else 'runs on'})"
+        if k == "oscillation":
+            f = f"{t['frequency_hz']:.1f} Hz " if "frequency_hz" in t else ""
+            return f"oscillation {f}({'rings' if t['ringing'] else 'runs on'})"
         if k in ("delay", "lag"): return f"{k}{' on '+t['channel'] if k=='lag' else ''} {t['seconds']*1e3:.3f} ms"
-        if k == "state": return f"state: {', '.join(t['functions'])}"
+        if k == "state": return f"state{' ('+t['balance']+')' if 'balance' in t else ''}: {', '.join(t['functions'])}"
         return f"{k}: {t.get('variable','')}"
     def law(x):
         # The equation as the report prints it, its 95% intervals shortened.
