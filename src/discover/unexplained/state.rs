@@ -87,6 +87,13 @@ fn sampled_ripple(k: f64, speed: f64, interval: f64) -> bool {
 /// With seven columns the first needs ½·ln N + ln 7 + 2 = 7.4 nats at N = 1002: as the
 /// balances' selection reasons, about 7·P(χ²₁ > 14.9) ≈ 0.1% per channel on a null record.
 const MEASURED: [usize; 7] = [0, 1, 2, 5, 7, 9, 12];
+/// Those of them that read the speed (`omega`, `omega*|omega|`, `omega^3`), and the current
+/// (`I`, `I*|I|`): offered only where the record measures that channel, whose prediction they
+/// are evaluated on.
+const READS_SPEED: [usize; 3] = [0, 1, 2];
+const READS_CURRENT: [usize; 2] = [5, 7];
+/// The speed itself read on the speed's channel: a gain, the library's `speed_gain`.
+const SPEED: usize = 0;
 
 /// A column of the regression: a function (dictionary index) and the shape it has, the
 /// Stribeck speed or the angle's harmonic.
@@ -344,9 +351,9 @@ fn measurement_fingerprints(fit: &Candidate, ctx: &Context, shift: f64) -> Vec<E
         }
         let functions: Vec<usize> = MEASURED
             .into_iter()
-            .filter(|&f| !(Some(c) == speed && f == 0))
-            .filter(|&f| speed.is_some() || f > 2)
-            .filter(|&f| current.is_some() || !(f == 5 || f == 7))
+            .filter(|&f| !(Some(c) == speed && f == SPEED))
+            .filter(|f| speed.is_some() || !READS_SPEED.contains(f))
+            .filter(|f| current.is_some() || !READS_CURRENT.contains(f))
             .collect();
         let mut b = DMatrix::zeros(ctx.m(), functions.len());
         for i in 0..ctx.n {
