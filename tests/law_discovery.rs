@@ -7,7 +7,9 @@
 //! and holds the true functions with coefficients near the truth, leaving nothing. Null
 //! records of the crate's own generator, with every candidate allowed, discover nothing.
 
-use std::path::{Path, PathBuf};
+mod beyond;
+
+use beyond::{fixture, truth_value};
 
 use motorcal::discover::{Diagnosis, DiscoverSettings, Discovered, discover};
 use motorcal::motor::MotorParam;
@@ -21,29 +23,6 @@ fn settings() -> DiscoverSettings {
     };
     s.run.quiet = true;
     s
-}
-
-fn fixture(name: &str) -> (Problem, serde_json::Value) {
-    let dir: PathBuf = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/fixtures/beyond")
-        .join(name);
-    let problem =
-        Problem::from_files(&[dir.join("recording.csv")], &dir.join("motor.toml")).unwrap();
-    let answer =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("answer.json")).unwrap()).unwrap();
-    (problem, answer)
-}
-
-/// A number of the truth's debug text, e.g. `mu` of `LoadFriction { mu: 0.00016 }`.
-fn truth_value(answer: &serde_json::Value, key: &str) -> f64 {
-    let text = answer["truth"].as_str().unwrap();
-    let at = text.find(&format!("{key}: ")).unwrap() + key.len() + 2;
-    text[at..]
-        .split([',', ' ', '}'])
-        .next()
-        .unwrap()
-        .parse()
-        .unwrap()
 }
 
 fn diagnose(problem: &Problem) -> Diagnosis {

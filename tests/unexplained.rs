@@ -14,9 +14,11 @@
 //! `sensor_lag` and `compliant_coupling`: "beyond the library" means beyond the candidates the
 //! diagnosis is given. Rank-only, a few seconds a case.
 
-use std::path::{Path, PathBuf};
+mod beyond;
 
-use motorcal::discover::{DiscoverSettings, Fingerprint, Unexplained, discover};
+use beyond::{fixture, truth_value};
+
+use motorcal::discover::{Diagnosis, DiscoverSettings, Fingerprint, Unexplained, discover};
 use motorcal::study::cases::{CaseOptions, make_case};
 use motorcal::study::{InputProfile, Problem};
 
@@ -46,15 +48,12 @@ fn settings() -> DiscoverSettings {
     s
 }
 
-fn fixture(name: &str) -> (Problem, serde_json::Value) {
-    let dir: PathBuf = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/fixtures/beyond")
-        .join(name);
-    let problem =
-        Problem::from_files(&[dir.join("recording.csv")], &dir.join("motor.toml")).unwrap();
-    let answer =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("answer.json")).unwrap()).unwrap();
-    (problem, answer)
+/// The diagnosis with the whole library, the dynamic terms included, as `diagnose` runs by
+/// default.
+fn whole_library(problem: &Problem) -> Diagnosis {
+    let mut s = settings();
+    s.candidates = None;
+    discover(problem, &s).unwrap()
 }
 
 fn verdict(problem: &Problem) -> Option<Unexplained> {
@@ -157,9 +156,7 @@ fn a_recording_of_the_model_itself_leaves_nothing_unexplained() {
 fn a_current_that_runs_ahead_of_the_model_is_not_nothing_missing() {
     let (problem, answer) = fixture("inductance_saturation-570010");
     assert!(answer["miss_nats"].as_f64().unwrap() >= 30.0);
-    let mut s = settings();
-    s.candidates = None;
-    let d = discover(&problem, &s).unwrap();
+    let d = whole_library(&problem);
     assert!(d.residual_mismatch);
     let u = d
         .unexplained
@@ -181,15 +178,8 @@ fn a_current_that_runs_ahead_of_the_model_is_not_nothing_missing() {
 #[test]
 fn a_current_sensor_that_also_reads_the_input_is_fingerprinted_as_a_measurement() {
     let (problem, answer) = fixture("leakage_current-580010");
-    let truth = answer["truth"].as_str().unwrap();
-    let g: f64 = truth
-        .trim_start_matches("LeakageCurrent { g: ")
-        .trim_end_matches(" }")
-        .parse()
-        .unwrap();
-    let mut s = settings();
-    s.candidates = None;
-    let d = discover(&problem, &s).unwrap();
+    let g = truth_value(&answer, "g");
+    let d = whole_library(&problem);
     let u = d
         .unexplained_as_given
         .expect("a leak 147 nats strong shows");
@@ -219,9 +209,7 @@ fn a_current_sensor_that_also_reads_the_input_is_fingerprinted_as_a_measurement(
 /// the verdict on the model as given, in the report beside it, is of the truth's kind.
 fn named_and_explained(name: &str, term: &str, key: &str, truth_key: &str) {
     let (problem, answer) = fixture(name);
-    let mut s = settings();
-    s.candidates = None;
-    let d = discover(&problem, &s).unwrap();
+    let d = whole_library(&problem);
     eprintln!("{name}: {:?} {:?}", d.selected_set, d.selected_params);
     assert_eq!(d.selected_set, vec![term.to_string()], "{name}");
     let estimate = d.selected_params[&format!("{term}.{key}")];
@@ -268,9 +256,7 @@ fn a_ringing_fingerprint_names_compliant_coupling_and_its_fit_leaves_nothing() {
 fn a_ringing_sensor_taken_up_by_a_lag_is_still_reported_as_a_resonance_of_the_sensor() {
     let (problem, answer) = fixture("resonant_sensor-510014");
     let truth = answer["fingerprint"]["frequency_hz"].as_f64().unwrap();
-    let mut s = settings();
-    s.candidates = None;
-    let d = discover(&problem, &s).unwrap();
+    let d = whole_library(&problem);
     eprintln!(
         "{:?}; {:?}",
         d.selected_set,
@@ -309,12 +295,7 @@ fn a_ringing_sensor_taken_up_by_a_lag_is_still_reported_as_a_resonance_of_the_se
 #[test]
 fn friction_growing_with_the_current_is_fingerprinted_as_a_law_of_the_state() {
     let (problem, answer) = fixture("load_friction-510012");
-    let truth = answer["truth"].as_str().unwrap();
-    let mu: f64 = truth
-        .trim_start_matches("LoadFriction { mu: ")
-        .trim_end_matches(" }")
-        .parse()
-        .unwrap();
+    let mu = truth_value(&answer, "mu");
     let u = verdict(&problem).expect("friction no library term holds is not 'nothing missing'");
     match u.fingerprint {
         Fingerprint::State {

@@ -230,14 +230,22 @@ impl Context {
     }
 }
 
-/// A generic alternative's result: the best polynomial or autoregression of a channel.
+/// A generic alternative's result on a channel.
 #[derive(Clone)]
 struct Generic {
     channel: usize,
-    polynomial: bool,
-    /// The channel's derivative with a lead's sign: the channel runs ahead of the model.
-    lead: bool,
+    kind: GenericKind,
     scored: Scored,
+}
+
+/// What a generic alternative is: it can hold "anything" of its shape.
+#[derive(Clone, Copy, PartialEq)]
+enum GenericKind {
+    /// A Legendre polynomial in time (the report's `where` is read off the best one).
+    Polynomial,
+    Autoregression,
+    /// The channel's derivative with a lead's sign: the channel runs ahead of the model.
+    Lead,
 }
 
 /// The verdict's report: `null` in the JSON when nothing is left.
@@ -317,8 +325,7 @@ fn scores(ctx: &Context, shift: f64) -> Scores {
             let b = ctx.in_channel(c, &basis.matrix(&ctx.times));
             generic.push(Generic {
                 channel: c,
-                polynomial: true,
-                lead: false,
+                kind: GenericKind::Polynomial,
                 scored: ctx.score(&b, 0.0),
             });
         }
@@ -332,8 +339,7 @@ fn scores(ctx: &Context, shift: f64) -> Scores {
             );
             generic.push(Generic {
                 channel: c,
-                polynomial: false,
-                lead: false,
+                kind: GenericKind::Autoregression,
                 scored: ctx.score(&ctx.in_channel(c, &lags), 0.0),
             });
         }
@@ -354,8 +360,7 @@ fn scores(ctx: &Context, shift: f64) -> Scores {
             // it says something is left, not what.
             generic.push(Generic {
                 channel: c,
-                polynomial: false,
-                lead: true,
+                kind: GenericKind::Lead,
                 scored: s.clone(),
             });
         }
@@ -540,7 +545,7 @@ pub fn unexplained(
             let polynomial = all
                 .generic
                 .iter()
-                .filter(|g| g.channel == c && g.polynomial)
+                .filter(|g| g.channel == c && g.kind == GenericKind::Polynomial)
                 .max_by(|a, b| a.scored.score.total_cmp(&b.scored.score));
             if let Some(g) = polynomial {
                 where_.extend(spans(&ctx, c, &g.scored.explained));
@@ -552,7 +557,7 @@ pub fn unexplained(
     }
     let mut suggestion = fingerprint.suggestion(&channels);
     if let (Fingerprint::Unknown { .. }, Some(g)) = (&fingerprint, best_generic)
-        && g.lead
+        && g.kind == GenericKind::Lead
     {
         suggestion = format!(
             "{} runs ahead of the model where it changes fast, as if that balance's fast \

@@ -1,0 +1,31 @@
+//! The independent-integrator cases the beyond-library tests share
+//! (`tests/fixtures/beyond/`, made by `examples/beyond_library_cases.rs`): a case's recording
+//! and nominal model as a problem, its answer, and the truth's parameters read from it.
+
+use std::path::{Path, PathBuf};
+
+use motorcal::study::Problem;
+
+/// The case `name`: its problem (recording and nominal model) and its `answer.json`.
+pub fn fixture(name: &str) -> (Problem, serde_json::Value) {
+    let dir: PathBuf = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fixtures/beyond")
+        .join(name);
+    let problem =
+        Problem::from_files(&[dir.join("recording.csv")], &dir.join("motor.toml")).unwrap();
+    let answer =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("answer.json")).unwrap()).unwrap();
+    (problem, answer)
+}
+
+/// A number of the truth's debug text, e.g. `mu` of `LoadFriction { mu: 0.00016 }`.
+pub fn truth_value(answer: &serde_json::Value, key: &str) -> f64 {
+    let text = answer["truth"].as_str().unwrap();
+    let at = text.find(&format!("{key}: ")).unwrap() + key.len() + 2;
+    text[at..]
+        .split([',', ' ', '}'])
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap()
+}
