@@ -203,7 +203,8 @@ impl ForwardModel {
             Ok(plain) => ode::solve(&plain, T0, &y0, &self.times, &self.solver, &mut states)?,
             Err(system) => ode::solve(&system, T0, &y0, &self.times, &self.solver, &mut states)?,
         };
-        self.model.measure(&states, p, &mut out[..n_channels * m]);
+        self.model
+            .measure(&self.times, &states, p, &mut out[..n_channels * m]);
         Ok(stats)
     }
 }

@@ -20,7 +20,8 @@ use serde::Serialize;
 use crate::error::Error;
 use crate::motor::Term;
 use crate::motor::dictionary::{
-    self, BALANCES, COS_THETA, CURRENT_LIMIT, FUNCTIONS, N_FUNCTIONS, PERIODIC, SIN_THETA, STRIBECK,
+    self, BALANCES, COS_THETA, CURRENT_LIMIT, FUNCTIONS, N_FUNCTIONS, ODE_BALANCES, PERIODIC,
+    SIN_THETA, STRIBECK,
 };
 use crate::motor::terms::Law;
 use crate::parameter::ParamId;
@@ -53,7 +54,7 @@ pub fn named_terms(problem: &Problem, fingerprint: &Fingerprint) -> Vec<NamedTer
             sensor: false,
             frequencies,
             ..
-        } => (0..BALANCES.len())
+        } => (0..ODE_BALANCES)
             .filter_map(|b| forced_law(problem, b, *frequency_hz, *frequencies))
             .collect(),
         _ => named_term(problem, fingerprint).into_iter().collect(),

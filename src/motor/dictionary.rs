@@ -8,7 +8,7 @@
 use super::{Magnitudes, Scalar};
 
 /// The functions, in the order of the law's parameters (within each balance).
-pub const FUNCTIONS: [&str; 21] = [
+pub const FUNCTIONS: [&str; 23] = [
     "omega",
     "omega*|omega|",
     "omega^3",
@@ -30,13 +30,21 @@ pub const FUNCTIONS: [&str; 21] = [
     "omega*heat",
     "I*heat",
     "sign(I)*max(|I|-I_lim,0)",
+    "theta",
+    "1",
 ];
 
 /// How many functions the dictionary holds.
 pub const N_FUNCTIONS: usize = FUNCTIONS.len();
 
-/// The balances a law adds to, in the order of the law's parameters.
-pub const BALANCES: [&str; 2] = ["torque", "voltage"];
+/// The balances a law adds to, in the order of the law's parameters: the two of the ODE (J dω/dt,
+/// L dI/dt), then what is read of each measured channel (a sensor that also reads the input,
+/// the other channel, or its own nonlinearly: measured I += Σ c·f).
+pub const BALANCES: [&str; 4] = ["torque", "voltage", "measurement:I", "measurement:omega"];
+
+/// How many of [`BALANCES`] are the ODE's; those after them add to a measured channel (the
+/// channel of the same index: I, then ω).
+pub const ODE_BALANCES: usize = 2;
 
 /// The Stribeck function, whose speed ω_s is a shape.
 pub const STRIBECK: usize = 4;
@@ -63,6 +71,15 @@ pub const I_HEAT: usize = 19;
 /// law written by hand may hold it in the torque balance, a flux saturating above I_lim). Zero below the
 /// limit, so the sign of I is exact where it is not.
 pub const CURRENT_LIMIT: usize = 20;
+/// The angle turned since the record's start, θ = ∫ω dt: a torque that grows with how far the
+/// shaft has turned and not how fast (a return spring, a torsion bar, a cable winding up) is
+/// −k·θ. On a record that turns one way θ grows like the time, and before it was offered a
+/// spring was named a drift in time or a constant load stood in for it.
+pub const THETA: usize = 21;
+/// The constant: an offset of what is read (a speed sensor's zero; the current's is the
+/// library's `current_offset`). In a balance it would be a constant load or voltage, which
+/// the library's `load_torque` and `voltage_drop` hold, so it is offered in what is read only.
+pub const CONSTANT: usize = 22;
 
 /// Whether the state fingerprint offers function `f` in balance `b` (0 torque, 1 voltage): the
 /// supply scaled by its charge acts where the supply does, in the voltage balance; in the
@@ -81,10 +98,16 @@ pub const CURRENT_LIMIT: usize = 20;
 /// library's armature reaction holds smoothly; there the hinge is a bump confined to the
 /// start-up, free to absorb whatever else a start-up leaves (on the slow cogging record 530007
 /// it extended the ripple's law by a hinge at 15 A, where the truth has none).
+///
+/// The angle is offered in the torque balance only: a torque that winds up with the turn is a
+/// spring's; a voltage that does has no physics in a motor behind it (the angle's ripples,
+/// sin(k·θ) and cos(k·θ), are a commutator's in either).
 pub fn offered_in(f: usize, b: usize) -> bool {
     match f {
         OMEGA_HEAT | I_HEAT => false,
         U_CHARGE | CURRENT_LIMIT => b == 1,
+        THETA => b == 0,
+        CONSTANT => b >= ODE_BALANCES,
         _ => true,
     }
 }
@@ -94,7 +117,7 @@ pub fn state_of(function: usize) -> Option<usize> {
     match function {
         CHARGE | U_CHARGE => Some(0),
         HEAT | OMEGA_HEAT | I_HEAT => Some(1),
-        SIN_THETA | COS_THETA => Some(2),
+        SIN_THETA | COS_THETA | THETA => Some(2),
         _ => None,
     }
 }
@@ -168,6 +191,8 @@ pub fn value<D: Scalar>(f: usize, x: &Point<D>, s: &Shapes) -> D {
             };
             softplus * width * x.current.re().signum()
         }
+        THETA => x.theta,
+        CONSTANT => D::from(1.0),
         _ => unreachable!("the dictionary has {N_FUNCTIONS} functions"),
     }
 }
@@ -193,6 +218,8 @@ pub fn typical_size(f: usize, m: &Magnitudes) -> f64 {
         OMEGA_HEAT => m.speed * m.voltage * m.current * m.duration,
         I_HEAT => m.current * m.voltage * m.current * m.duration,
         TIME => m.duration,
+        // The angle the record's speed turns over it.
+        THETA => m.speed * m.duration,
         _ => 1.0,
     }
 }
@@ -212,6 +239,8 @@ pub fn units(f: usize) -> (&'static str, &'static str) {
         OMEGA_HEAT => ("N·m·s/(rad·J)", "V·s/(rad·J)"),
         I_HEAT => ("N·m/(A·J)", "Ω/J"),
         TIME => ("N·m/s", "V/s"),
+        THETA => ("N·m/rad", "V/rad"),
+        CONSTANT => ("N·m", "V"),
         _ => ("N·m", "V"),
     }
 }
@@ -227,7 +256,8 @@ pub fn key(k: usize) -> String {
 
 /// The law's parameter index of a key `balance:function`, or why there is none.
 pub fn index_of(key: &str) -> Result<usize, String> {
-    let Some((balance, function)) = key.split_once(':') else {
+    // The function's name holds no colon; a measurement balance's does.
+    let Some((balance, function)) = key.rsplit_once(':') else {
         return Err(format!(
             "'{key}' is not a law coefficient: write \"balance:function\", the balance one of \
              {}",
@@ -290,6 +320,22 @@ mod tests {
         assert!((value(COS_THETA, &x, &shapes(6.0)) - 1.8f64.cos()).abs() < 1e-12);
         assert_eq!(FUNCTIONS[SIN_THETA], "sin(k*theta)");
         assert_eq!(FUNCTIONS[COS_THETA], "cos(k*theta)");
+    }
+
+    /// Where each function may enter a fingerprint: the angle in the torque balance only (a
+    /// spring's), the constant in what is read only (in a balance it is a library term's).
+    #[test]
+    fn the_angle_winds_up_a_torque_and_the_constant_offsets_a_reading() {
+        assert_eq!(FUNCTIONS[THETA], "theta");
+        assert_eq!(FUNCTIONS[CONSTANT], "1");
+        let offered = |f| -> Vec<bool> { (0..BALANCES.len()).map(|b| offered_in(f, b)).collect() };
+        assert_eq!(offered(THETA), [true, false, false, false]);
+        assert_eq!(offered(CONSTANT), [false, false, true, true]);
+        assert_eq!(
+            index_of("measurement:omega:1"),
+            Ok(3 * N_FUNCTIONS + CONSTANT)
+        );
+        assert_eq!(key(2 * N_FUNCTIONS + THETA), "measurement:I:theta");
     }
 
     /// The current beyond a limit: nothing below it, the excess with the current's sign above

@@ -260,9 +260,10 @@ impl MotorModel {
         }
     }
 
-    /// The measurement map over a whole solution: `states` holds `n_states()` values per sample,
-    /// `out` is channel-major (`out[c * samples + i]`). I and ω as the sensor terms amend them.
-    pub fn measure<D: Scalar>(&self, states: &[D], p: &[D], out: &mut [D]) {
+    /// The measurement map over a whole solution: `states` holds `n_states()` values per sample
+    /// at `times`, `out` is channel-major (`out[c * samples + i]`). I and ω as the sensor terms
+    /// amend them.
+    pub fn measure<D: Scalar>(&self, times: &[f64], states: &[D], p: &[D], out: &mut [D]) {
         let n = self.n_states();
         let samples = states.len() / n;
         let n_channels = self.channels().len();
@@ -281,10 +282,18 @@ impl MotorModel {
             for c in 0..n_channels {
                 measured[c] = out[c * samples + i];
             }
+            let at = terms::Sample {
+                t: times[i],
+                voltage: self
+                    .input
+                    .value_at(times[i])
+                    .map_or(p[MotorParam::Voltage as usize], D::from),
+            };
             for (k, t) in self.terms.iter().enumerate() {
                 t.term.measure(
                     &p[self.param_offsets[k]..self.param_offsets[k + 1]],
                     &y[self.state_offsets[k]..self.state_offsets[k + 1]],
+                    at,
                     &mut measured,
                 );
             }

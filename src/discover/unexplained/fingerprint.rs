@@ -47,8 +47,8 @@ pub enum Fingerprint {
         score: f64,
     },
     /// The balance (`torque`, `voltage`) misses a sum of dictionary functions of the state, or
-    /// what is read of a channel does (`measurement:I`, `measurement:omega`: told, not fitted;
-    /// no law term holds a measurement yet).
+    /// what is read of a channel does (`measurement:I`, `measurement:omega`: the law's
+    /// measurement balances).
     State {
         balance: String,
         functions: Vec<LawFunction>,
@@ -181,9 +181,9 @@ impl Fingerprint {
                 balance, functions, ..
             } if balance.starts_with("measurement:") => format!(
                 "what is read of {} follows the state: {} fits what is left — a sensor that \
-                 also reads the input or the other channel (crosstalk; a leakage path on the \
-                 supply side of a current sensor), reads nonlinearly or drifts; no law term \
-                 holds a measurement yet",
+                 also reads the input (a leakage path on the supply side of a current \
+                 sensor), reads nonlinearly, clips at its range or drifts (the term law, in \
+                 what is read)",
                 balance.trim_start_matches("measurement:"),
                 equation(balance, functions)
             ),
@@ -269,10 +269,12 @@ pub fn equation_with(balance: &str, terms: &[EquationTerm]) -> String {
             (_, true) => (" − ", signed(-c)),
             (_, false) => (" + ", signed(*c)),
         };
-        text.push_str(&format!(
-            "{joint}{value}·{}{band}",
-            dictionary::pretty(name)
-        ));
+        // The constant is its coefficient alone.
+        let function = match name.as_str() {
+            "1" => String::new(),
+            _ => format!("·{}", dictionary::pretty(name)),
+        };
+        text.push_str(&format!("{joint}{value}{function}{band}"));
     }
     text
 }

@@ -1,6 +1,6 @@
 //! An offset of the current sensor: measured I = I + b_I.
 
-use super::{Magnitudes, PRIOR_SHARE, PhysicsTerm, TermParam, real};
+use super::{Magnitudes, PRIOR_SHARE, PhysicsTerm, Sample, TermParam, real};
 use crate::motor::Scalar;
 use crate::parameter::Prior;
 
@@ -30,7 +30,7 @@ impl PhysicsTerm for CurrentOffset {
         Ok(Self)
     }
 
-    fn measure<D: Scalar>(&self, p: &[D], _: &[D], channels: &mut [D]) {
+    fn measure<D: Scalar>(&self, p: &[D], _: &[D], _: Sample<D>, channels: &mut [D]) {
         channels[0] += p[0];
     }
 }

@@ -1,6 +1,7 @@
 //! A law of the state found beyond the library: Σ c·f(state, input) added to the torque balance
-//! (J dω/dt) or to the voltage balance (L dI/dt), the functions f from the fixed dictionary of
-//! `motor::dictionary`. Every (balance, function) pair is a parameter (default 0: absent), but
+//! (J dω/dt), to the voltage balance (L dI/dt), or to what is read of a channel (measured I or
+//! ω: a sensor's law, evaluated on the channels as the sensors before it read them), the
+//! functions f from the fixed dictionary of `motor::dictionary`. Every (balance, function) pair is a parameter (default 0: absent), but
 //! only the pairs the law lists are active: evaluated, written to the model file and
 //! calibrated. Three states follow the record for the functions that need them: the charge
 //! ∫|I|dt, the heat ∫R·I²dt and the angle θ = ∫ω dt, each integrated only when a listed function
@@ -10,11 +11,11 @@
 //! `discover::named` fits the law from its estimate.
 
 use super::{
-    Balance, Magnitudes, PRIOR_SHARE, PhysicsTerm, Site, TermParam, TermSetting, TermState,
+    Balance, Magnitudes, PRIOR_SHARE, PhysicsTerm, Sample, Site, TermParam, TermSetting, TermState,
     positive_setting, real,
 };
 use crate::motor::Scalar;
-use crate::motor::dictionary::{self, N_FUNCTIONS, Point, Shapes};
+use crate::motor::dictionary::{self, N_FUNCTIONS, ODE_BALANCES, Point, Shapes};
 use crate::parameter::Prior;
 
 #[derive(Clone, Debug, PartialEq)]
@@ -41,10 +42,11 @@ impl Law {
     }
 }
 
-/// One sd: a tenth of the balance's scale (stall torque, supply voltage) over the size the
-/// function typically takes on this machine and record.
+/// One sd: a tenth of the balance's scale (stall torque, supply voltage; the current and the
+/// speed scales for what is read of them) over the size the function typically takes on this
+/// machine and record.
 fn prior<const K: usize>(m: &Magnitudes) -> Prior {
-    let scale = if K < N_FUNCTIONS { m.torque } else { m.voltage };
+    let scale = [m.torque, m.voltage, m.current, m.speed][K / N_FUNCTIONS];
     let size = dictionary::typical_size(K % N_FUNCTIONS, m);
     let size = if size.is_finite() && size > 0.0 {
         size
@@ -58,9 +60,11 @@ fn prior<const K: usize>(m: &Magnitudes) -> Prior {
 }
 
 /// Each function of the dictionary (in its order) with its coefficient's unit in the torque
-/// and in the voltage balance: the torque coefficients, then the voltage ones.
+/// balance, the voltage balance, what is read of I and of ω: the torque coefficients, then the
+/// voltage ones, then the measured channels'.
 macro_rules! coefficients {
-    ($($k:literal $name:literal $torque:literal $voltage:literal),* $(,)?) => {
+    ($($k:literal $name:literal $torque:literal $voltage:literal $current:literal $speed:literal),*
+     $(,)?) => {
         &[
             $(TermParam {
                 key: concat!("torque:", $name),
@@ -76,6 +80,20 @@ macro_rules! coefficients {
                 support: real,
                 prior: prior::<{ $k + N_FUNCTIONS }>,
             },)*
+            $(TermParam {
+                key: concat!("measurement:I:", $name),
+                unit: $current,
+                default: 0.0,
+                support: real,
+                prior: prior::<{ $k + 2 * N_FUNCTIONS }>,
+            },)*
+            $(TermParam {
+                key: concat!("measurement:omega:", $name),
+                unit: $speed,
+                default: 0.0,
+                support: real,
+                prior: prior::<{ $k + 3 * N_FUNCTIONS }>,
+            },)*
         ]
     };
 }
@@ -87,27 +105,29 @@ impl PhysicsTerm for Law {
     const NOT_ON_DRIVES: &'static str =
         "is written for the voltage-driven motor's two balances (a drive base's law is not yet)";
     const PARAMS: &'static [TermParam] = coefficients!(
-        0 "omega" "N·m·s/rad" "V·s/rad",
-        1 "omega*|omega|" "N·m·s²/rad²" "V·s²/rad²",
-        2 "omega^3" "N·m·s³/rad³" "V·s³/rad³",
-        3 "sign(omega)" "N·m" "V",
-        4 "exp(-(omega/omega_s)^2)*sign(omega)" "N·m" "V",
-        5 "I" "N·m/A" "Ω",
-        6 "|I|" "N·m/A" "Ω",
-        7 "I*|I|" "N·m/A²" "V/A²",
-        8 "sign(omega)*|I|" "N·m/A" "Ω",
-        9 "U" "N·m/V" "1",
-        10 "charge" "N·m/(A·s)" "V/(A·s)",
-        11 "heat" "N·m/J" "V/J",
-        12 "t" "N·m/s" "V/s",
-        13 "sin(k*theta)" "N·m" "V",
-        14 "cos(k*theta)" "N·m" "V",
-        15 "sin(2*pi*f*t)" "N·m" "V",
-        16 "cos(2*pi*f*t)" "N·m" "V",
-        17 "U*charge" "N·m/(V·A·s)" "1/(A·s)",
-        18 "omega*heat" "N·m·s/(rad·J)" "V·s/(rad·J)",
-        19 "I*heat" "N·m/(A·J)" "Ω/J",
-        20 "sign(I)*max(|I|-I_lim,0)" "N·m/A" "Ω",
+        0 "omega" "N·m·s/rad" "V·s/rad" "A·s/rad" "1",
+        1 "omega*|omega|" "N·m·s²/rad²" "V·s²/rad²" "A·s²/rad²" "s/rad",
+        2 "omega^3" "N·m·s³/rad³" "V·s³/rad³" "A·s³/rad³" "s²/rad²",
+        3 "sign(omega)" "N·m" "V" "A" "rad/s",
+        4 "exp(-(omega/omega_s)^2)*sign(omega)" "N·m" "V" "A" "rad/s",
+        5 "I" "N·m/A" "Ω" "1" "rad/(s·A)",
+        6 "|I|" "N·m/A" "Ω" "1" "rad/(s·A)",
+        7 "I*|I|" "N·m/A²" "V/A²" "1/A" "rad/(s·A²)",
+        8 "sign(omega)*|I|" "N·m/A" "Ω" "1" "rad/(s·A)",
+        9 "U" "N·m/V" "1" "S" "rad/(s·V)",
+        10 "charge" "N·m/(A·s)" "V/(A·s)" "1/s" "rad/(s²·A)",
+        11 "heat" "N·m/J" "V/J" "A/J" "rad/(s·J)",
+        12 "t" "N·m/s" "V/s" "A/s" "rad/s²",
+        13 "sin(k*theta)" "N·m" "V" "A" "rad/s",
+        14 "cos(k*theta)" "N·m" "V" "A" "rad/s",
+        15 "sin(2*pi*f*t)" "N·m" "V" "A" "rad/s",
+        16 "cos(2*pi*f*t)" "N·m" "V" "A" "rad/s",
+        17 "U*charge" "N·m/(V·A·s)" "1/(A·s)" "1/(V·s)" "rad/(s²·V·A)",
+        18 "omega*heat" "N·m·s/(rad·J)" "V·s/(rad·J)" "A·s/(rad·J)" "1/J",
+        19 "I*heat" "N·m/(A·J)" "Ω/J" "1/J" "rad/(s·A·J)",
+        20 "sign(I)*max(|I|-I_lim,0)" "N·m/A" "Ω" "1" "rad/(s·A)",
+        21 "theta" "N·m/rad" "V/rad" "A/rad" "1/s",
+        22 "1" "N·m" "V" "A" "rad/s",
     );
     const SETTINGS: &'static [TermSetting] = &[
         TermSetting {
@@ -206,13 +226,39 @@ impl PhysicsTerm for Law {
             heat: site.states[1],
             theta: site.states[2],
         };
-        for &k in &self.active {
+        for &k in self
+            .active
+            .iter()
+            .filter(|&&k| k < ODE_BALANCES * N_FUNCTIONS)
+        {
             let term = site.params[k] * dictionary::value(k % N_FUNCTIONS, &x, &self.shapes);
             if k < N_FUNCTIONS {
                 b.torque += term;
             } else {
                 b.voltage += term;
             }
+        }
+    }
+
+    /// What is read of I and ω, plus the law's measurement functions of the state as the
+    /// sensors before it read it (the channels as they arrive), the input and the time.
+    fn measure<D: Scalar>(&self, params: &[D], states: &[D], at: Sample<D>, channels: &mut [D]) {
+        let first = ODE_BALANCES * N_FUNCTIONS;
+        if self.active.last().is_none_or(|&k| k < first) {
+            return;
+        }
+        let x = Point {
+            t: at.t,
+            current: channels[0],
+            speed: channels[1],
+            voltage: at.voltage,
+            charge: states[0],
+            heat: states[1],
+            theta: states[2],
+        };
+        for &k in self.active.iter().filter(|&&k| k >= first) {
+            let read = params[k] * dictionary::value(k % N_FUNCTIONS, &x, &self.shapes);
+            channels[k / N_FUNCTIONS - ODE_BALANCES] += read;
         }
     }
 

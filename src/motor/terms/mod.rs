@@ -42,6 +42,15 @@ pub struct TermSetting {
     pub choices: &'static [&'static str],
 }
 
+/// Where a measurement is read: the sample's time and the input the drive applies then (the
+/// voltage held then, or the constant parameter U; before any term shifts it), for a sensor
+/// that reads the input or drifts with the time besides its own channel.
+#[derive(Clone, Copy, Debug)]
+pub struct Sample<D> {
+    pub t: f64,
+    pub voltage: D,
+}
+
 /// A state a term adds to the ODE, with its initial value.
 pub struct TermState {
     pub name: &'static str,
@@ -89,7 +98,14 @@ pub trait PhysicsTerm: Sized + Clone + std::fmt::Debug + PartialEq {
     /// there, `input` its whole history as steps, for a term that shifts it in time.
     fn input<D: Scalar>(&self, _params: &[D], _t: f64, _input: &InputSteps<D>, _u: &mut D) {}
     /// Amends the measured channels (I, ω); `states` are the term's own at that sample.
-    fn measure<D: Scalar>(&self, _params: &[D], _states: &[D], _channels: &mut [D]) {}
+    fn measure<D: Scalar>(
+        &self,
+        _params: &[D],
+        _states: &[D],
+        _at: Sample<D>,
+        _channels: &mut [D],
+    ) {
+    }
     /// Times at which the term makes the right-hand side jump, at nominal parameter values.
     fn breakpoints(&self, _params: &[f64]) -> Vec<f64> {
         Vec::new()
@@ -284,8 +300,14 @@ macro_rules! terms {
             }
 
             #[inline]
-            pub fn measure<D: Scalar>(&self, params: &[D], states: &[D], channels: &mut [D]) {
-                match self { $(Term::$variant(t) => t.measure(params, states, channels)),* }
+            pub fn measure<D: Scalar>(
+                &self,
+                params: &[D],
+                states: &[D],
+                at: Sample<D>,
+                channels: &mut [D],
+            ) {
+                match self { $(Term::$variant(t) => t.measure(params, states, at, channels)),* }
             }
 
             pub fn breakpoints(&self, params: &[f64]) -> Vec<f64> {

@@ -4,7 +4,7 @@
 //! integrated and the channel is measured as it is.
 
 use super::{
-    Balance, Magnitudes, PRIOR_SHARE, PhysicsTerm, Site, TermParam, TermSetting, TermState,
+    Balance, Magnitudes, PRIOR_SHARE, PhysicsTerm, Sample, Site, TermParam, TermSetting, TermState,
     positive,
 };
 use crate::motor::Scalar;
@@ -81,7 +81,7 @@ impl PhysicsTerm for SensorLag {
         }
     }
 
-    fn measure<D: Scalar>(&self, params: &[D], states: &[D], channels: &mut [D]) {
+    fn measure<D: Scalar>(&self, params: &[D], states: &[D], _: Sample<D>, channels: &mut [D]) {
         if params[0].re() > 0.0 {
             channels[self.channel] = states[0];
         }

@@ -1,6 +1,6 @@
 //! A speed sensor with a gain error: measured ω = (1 + g)·ω.
 
-use super::{PhysicsTerm, TermParam, relative_param};
+use super::{PhysicsTerm, Sample, TermParam, relative_param};
 use crate::motor::Scalar;
 
 #[derive(Clone, Debug, PartialEq)]
@@ -15,7 +15,7 @@ impl PhysicsTerm for SpeedGain {
         Ok(Self)
     }
 
-    fn measure<D: Scalar>(&self, p: &[D], _: &[D], channels: &mut [D]) {
+    fn measure<D: Scalar>(&self, p: &[D], _: &[D], _: Sample<D>, channels: &mut [D]) {
         channels[1] *= p[0] + 1.0;
     }
 }
