@@ -16,7 +16,8 @@
 //! set so that its seeds keep their cases: `cogging`, and `flux_saturation`, `thermal_magnet`,
 //! `current_limit`, `supply_ripple` (a stand-in for the private holdout's effects not named),
 //! and a second such set made after the first was worked on: `inductance_saturation`,
-//! `return_spring`, `load_ripple`; then `leakage_current`, `tacho_nonlinearity`, `backlash`.
+//! `return_spring`, `load_ripple`; then `leakage_current`, `tacho_nonlinearity`, `backlash`;
+//! a third, `current_clip`, `amplifier_saturation`, `speed_quantization`, and `speed_offset`.
 //!
 //! cargo run --release --example beyond_library_cases -- [--out DIR] [--per-effect 3]
 //!     [--seed-base 510000] [--min-nats 20] [--max-nats 300] [--effects a,b,…] [--volts 24]
@@ -108,6 +109,18 @@ enum Effect {
     /// A gearbox's backlash: the load (share s of the inertia) on a stiff shaft (300 Hz,
     /// ζ 0.1) that transmits nothing while the twist is inside ±b rad. `--effects backlash`.
     Backlash { share: f64, gap: f64 },
+    /// The current sensor's range: what is read is I clipped to ±I_sat (an ADC that saturates
+    /// on the start-up's peak). `--effects current_clip`.
+    CurrentClip { i_sat: f64 },
+    /// The drive's output stage saturating below the commanded voltage: the motor gets U
+    /// clipped to ±U_max. `--effects amplifier_saturation`.
+    AmplifierSaturation { u_max: f64 },
+    /// An encoder's speed: ω read in steps of q rad/s (counts per sample period).
+    /// `--effects speed_quantization`.
+    SpeedQuantization { q: f64 },
+    /// A speed sensor's offset: ω read as ω + b (the library holds the current's offset, not
+    /// the speed's). `--effects speed_offset`.
+    SpeedOffset { b: f64 },
 }
 
 impl Effect {
@@ -178,6 +191,10 @@ impl Effect {
                 share: rng.random_range(0.3..0.7),
                 gap: 1e-2,
             },
+            "current_clip" => Effect::CurrentClip { i_sat: 200.0 },
+            "amplifier_saturation" => Effect::AmplifierSaturation { u_max: 20.0 },
+            "speed_quantization" => Effect::SpeedQuantization { q: 5.0 },
+            "speed_offset" => Effect::SpeedOffset { b: 5.0 },
             other => panic!("unknown effect {other}; known: {:?}", Effect::NAMES),
         }
     }
@@ -205,6 +222,10 @@ impl Effect {
             Effect::LeakageCurrent { g } => g,
             Effect::TachoNonlinearity { a } => a,
             Effect::Backlash { gap, .. } => gap,
+            Effect::CurrentClip { i_sat } => 1.0 / i_sat,
+            Effect::AmplifierSaturation { u_max } => 1.0 / u_max,
+            Effect::SpeedQuantization { q } => q,
+            Effect::SpeedOffset { b } => b,
         }
     }
 
@@ -230,6 +251,10 @@ impl Effect {
             Effect::LeakageCurrent { g } => *g = s,
             Effect::TachoNonlinearity { a } => *a = s,
             Effect::Backlash { gap, .. } => *gap = s,
+            Effect::CurrentClip { i_sat } => *i_sat = 1.0 / s,
+            Effect::AmplifierSaturation { u_max } => *u_max = 1.0 / s,
+            Effect::SpeedQuantization { q } => *q = s,
+            Effect::SpeedOffset { b } => *b = s,
         }
         e
     }
@@ -250,6 +275,12 @@ impl Effect {
             // A leak of at most 10 Ω; a gap of at most half a radian.
             Effect::LeakageCurrent { .. } => 0.1,
             Effect::Backlash { .. } => 0.5,
+            // A range of at least 10 A; an output stage of at least 4 V; steps of at most a
+            // tenth of the top speed.
+            Effect::CurrentClip { .. } => 0.1,
+            Effect::AmplifierSaturation { .. } => 0.25,
+            Effect::SpeedQuantization { .. } => 240.0,
+            Effect::SpeedOffset { .. } => 100.0,
             _ => 1.0,
         }
     }
@@ -371,8 +402,16 @@ fn rhs(
             torque -= eps * m.c_g * i * (k as f64 * x[2] + phase).sin();
             dx[2] = w;
         }
+        Some(&Effect::AmplifierSaturation { u_max }) => u = u.clamp(-u_max, u_max),
         // These act on what is measured (`measured`, `simulate`), not on the motor.
-        Some(Effect::LeakageCurrent { .. } | Effect::TachoNonlinearity { .. }) | None => {}
+        Some(
+            Effect::LeakageCurrent { .. }
+            | Effect::TachoNonlinearity { .. }
+            | Effect::CurrentClip { .. }
+            | Effect::SpeedQuantization { .. }
+            | Effect::SpeedOffset { .. },
+        )
+        | None => {}
     }
     // With a coupling, the viscous loss acts on the load side.
     let d_motor = if matches!(
@@ -394,6 +433,9 @@ fn measured(e: Option<&Effect>, x: &[f64; 4]) -> [f64; 2] {
         Some(&Effect::SensorLag { channel: 0, .. }) => [x[2], x[1]],
         Some(&Effect::SensorLag { .. }) => [x[0], x[2]],
         Some(&Effect::TachoNonlinearity { a }) => [x[0], x[1] + a * x[1] * x[1].abs()],
+        Some(&Effect::CurrentClip { i_sat }) => [x[0].clamp(-i_sat, i_sat), x[1]],
+        Some(&Effect::SpeedQuantization { q }) => [x[0], q * (x[1] / q).round()],
+        Some(&Effect::SpeedOffset { b }) => [x[0], x[1] + b],
         _ => [x[0], x[1]],
     }
 }
@@ -509,12 +551,18 @@ fn expected(e: &Effect) -> String {
         Effect::SupplyRipple { f, .. } => format!(r#"{{"kind": "oscillation", "frequency_hz": {f}, "ringing": false}}"#),
         // dI/dt is in no dictionary: the tool should say something is left, not what.
         Effect::InductanceSaturation { .. } => r#"{"kind": "unknown"}"#.into(),
-        // θ itself is in no dictionary; on a record that turns one way it grows like the time.
-        Effect::ReturnSpring { .. } => r#"{"kind": "drift", "variable": "time"}"#.into(),
+        Effect::ReturnSpring { .. } => r#"{"kind": "state", "balance": "torque", "functions": ["theta"]}"#.into(),
         Effect::LeakageCurrent { .. } => r#"{"kind": "state", "balance": "measurement:I", "functions": ["U"]}"#.into(),
         Effect::TachoNonlinearity { .. } => r#"{"kind": "state", "balance": "measurement:omega", "functions": ["omega*|omega|"]}"#.into(),
         // The load's impact as the gap closes rings the shaft.
         Effect::Backlash { .. } => r#"{"kind": "oscillation", "channel": "omega", "ringing": true}"#.into(),
+        // What is read of I, clipped: a function of I no dictionary holds (a hinge in the
+        // reading).
+        Effect::CurrentClip { .. } => r#"{"kind": "state", "balance": "measurement:I", "functions": ["I"]}"#.into(),
+        // The supply's voltage beyond the stage's limit, lost: a function of U.
+        Effect::AmplifierSaturation { .. } => r#"{"kind": "state", "balance": "voltage", "functions": ["U"]}"#.into(),
+        Effect::SpeedOffset { .. } => r#"{"kind": "state", "balance": "measurement:omega", "functions": ["1"]}"#.into(),
+        Effect::SpeedQuantization { .. } => r#"{"kind": "state", "balance": "measurement:omega", "functions": ["omega"]}"#.into(),
         Effect::LoadRipple { k, .. } => format!(r#"{{"kind": "state", "balance": "torque", "functions": ["sin(k*theta)", "cos(k*theta)"], "k": {k}}}"#),
     }
 }
