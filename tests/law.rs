@@ -1,5 +1,6 @@
 //! The law term: each dictionary function's coefficient has the sensitivity finite differences
-//! of the simulated channels give, in either balance; a law holding one library term's shape is
+//! of the simulated channels give, in either balance and in what is read of either channel; a
+//! law of what is read adds to the reading alone; a law holding one library term's shape is
 //! that term (viscous friction, Coulomb friction); a model file with a law reads back as
 //! written, with its active coefficients alone; an unknown function is refused with the file
 //! and the key named.
@@ -37,7 +38,7 @@ fn law(active: &[(usize, f64)]) -> ActiveTerm {
         panic!("law is a term");
     };
     let law = law.with_active(active.iter().map(|a| a.0).collect());
-    let mut values = vec![0.0; 2 * N_FUNCTIONS];
+    let mut values = vec![0.0; dictionary::BALANCES.len() * N_FUNCTIONS];
     for &(k, v) in active {
         values[k] = v;
     }
@@ -72,7 +73,9 @@ fn peak(v: &[f64]) -> f64 {
 fn the_law_s_parameters_are_the_dictionary_in_each_balance() {
     let term = Term::named("law").unwrap();
     let keys: Vec<&str> = term.params().iter().map(|p| p.key).collect();
-    let expected: Vec<String> = (0..2 * N_FUNCTIONS).map(dictionary::key).collect();
+    let expected: Vec<String> = (0..dictionary::BALANCES.len() * N_FUNCTIONS)
+        .map(dictionary::key)
+        .collect();
     assert_eq!(keys, expected);
     assert!(
         !Term::NAMES.contains(&"law"),
@@ -86,7 +89,7 @@ fn the_law_s_parameters_are_the_dictionary_in_each_balance() {
 fn every_coefficient_s_sensitivity_matches_finite_differences() {
     let magnitudes = model(Vec::new()).magnitudes(0.5);
     let decls = Term::named("law").unwrap().params();
-    assert_eq!(decls.len(), 2 * N_FUNCTIONS);
+    assert_eq!(decls.len(), dictionary::BALANCES.len() * N_FUNCTIONS);
     for (k, decl) in decls.iter().enumerate() {
         let sd = (decl.prior)(&magnitudes).variance().sqrt();
         let theta = 0.1 * sd;
@@ -154,6 +157,35 @@ fn a_law_in_a_library_term_s_shape_is_that_term() {
         assert!(effect > 1.0, "{name}: the effect is visible");
         assert!(gap < 1e-6 * effect, "{name}: the law differs by {gap}");
     }
+}
+
+/// A law in what is read of I adds to the measured current alone, exactly: a current sensor
+/// that also reads the input through a leak, I + g·U, changes neither the dynamics (ω is the
+/// plain model's) nor anything but the reading.
+#[test]
+fn a_law_of_what_is_read_adds_to_the_reading_and_not_to_the_dynamics() {
+    let key = dictionary::index_of("measurement:I:U").unwrap();
+    let g = 0.05;
+    let leaky = simulate(vec![law(&[(key, g)])]);
+    let plain = simulate(Vec::new());
+    let n = plain.len() / 2;
+    let times = grid(1e-3, 0.5);
+    let input = model(Vec::new()).input;
+    for i in 0..n {
+        let u = input.value_at(times[i]).unwrap();
+        // To the last digits: a model with no term is solved by the unrolled plain system.
+        assert!(
+            (leaky[i] - plain[i] - g * u).abs() < 1e-8,
+            "I at sample {i}"
+        );
+        let speed = plain[n + i].abs().max(1.0);
+        assert!(
+            (leaky[n + i] - plain[n + i]).abs() < 1e-10 * speed,
+            "ω at sample {i}"
+        );
+    }
+    // Keyed with the channel's balance, which holds a colon itself.
+    assert_eq!(dictionary::key(key), "measurement:I:U");
 }
 
 fn scratch(tag: &str) -> std::path::PathBuf {

@@ -2,7 +2,9 @@
 //! the independent RK4 integrator of `examples/beyond_library_cases.rs` (seeds 510006, 510012,
 //! 510013 and 510015 of `--per-effect 2 --seed-base 510000`; supply ripples 560004 and 560012 of
 //! `--effects flux_saturation,thermal_magnet,current_limit,supply_ripple --per-effect 3
-//! --seed-base 560000`, as is current_limit-560011; the answer beside each recording), leave a state fingerprint or a
+//! --seed-base 560000`, as is current_limit-560011; a return spring, a leaking and a clipping
+//! current sensor and a speed sensor's offset, named at their tests; the answer beside each recording), leave a state
+//! fingerprint or a
 //! forced oscillation; the law term written from it is fitted, taken by the ranking's threshold,
 //! and holds the true functions with coefficients near the truth, leaving nothing. Null
 //! records of the crate's own generator, with every candidate allowed, discover nothing.
@@ -215,6 +217,91 @@ fn a_drives_current_limit_is_discovered_with_its_level() {
         law.equation
     );
     assert!(d.unexplained.is_none(), "{:?}", d.unexplained);
+}
+
+/// A return spring (−k·θ, θ the angle turned; return_spring-570008 of `--effects
+/// inductance_saturation,return_spring,load_ripple --per-effect 4 --seed-base 570000`): on a
+/// record that turns one way the angle grows like the time, and a load torque or a drift in t
+/// stood in for it before the angle was in the dictionary. The law in the torque balance in θ
+/// alone, its 95% interval holding −k.
+#[test]
+fn a_return_spring_is_discovered_as_a_law_of_the_angle() {
+    let (problem, answer) = fixture("return_spring-570008");
+    let k = truth_value(&answer, "k");
+    let d = diagnose(&problem);
+    let law = d.discovered.expect("a law is discovered");
+    assert_eq!(law.balance, "torque");
+    let names: Vec<&str> = law.functions.iter().map(|f| f.name.as_str()).collect();
+    assert_eq!(names, ["theta"]);
+    let f = &law.functions[0];
+    assert!(f.q025 <= -k && -k <= f.q975, "{} vs −{k}", law.equation);
+}
+
+/// A leak on the supply side of the current sensor (what is read is I + g·U;
+/// leakage_current-580010, a held input, of `--effects leakage_current,tacho_nonlinearity,backlash
+/// --per-effect 4 --seed-base 580000`): three library terms stood in for it before the law could
+/// hold what is read. The law in the reading of I, in U alone, its 95% interval holding g.
+#[test]
+fn a_leak_on_the_current_sensor_is_discovered_as_a_law_of_what_is_read() {
+    let (problem, answer) = fixture("leakage_current-580010");
+    let g = truth_value(&answer, "g");
+    let d = diagnose(&problem);
+    assert_eq!(d.selected_set, ["law"], "no library term beside it");
+    let law = d.discovered.expect("a law is discovered");
+    assert_eq!(law.balance, "measurement:I");
+    let names: Vec<&str> = law.functions.iter().map(|f| f.name.as_str()).collect();
+    assert_eq!(names, ["U"]);
+    let f = &law.functions[0];
+    assert!(f.q025 <= g && g <= f.q975, "{} vs {g}", law.equation);
+    assert!(law.equation.starts_with("measured I"), "{}", law.equation);
+}
+
+/// A current sensor that clips at its range (what is read is I held within ±I_sat;
+/// current_clip-590001 of `--effects current_clip,amplifier_saturation,speed_quantization
+/// --per-effect 4 --seed-base 590000`): before the reading was offered the current beyond a
+/// limit, the drive's current limit in the voltage balance stood in for it, acting on the
+/// motor where the clip acts on the reading alone. The law in the reading of I, the limit
+/// within 3% of I_sat, the interval of its coefficient holding −1 (all of the current beyond
+/// the range is lost to the reading).
+#[test]
+fn a_current_reading_clipped_at_its_range_is_discovered_as_a_clip_not_a_drive_limit() {
+    let (problem, answer) = fixture("current_clip-590001");
+    let i_sat = truth_value(&answer, "i_sat");
+    let d = diagnose(&problem);
+    let law = d.discovered.expect("a law is discovered");
+    assert_eq!(law.balance, "measurement:I");
+    let names: Vec<&str> = law.functions.iter().map(|f| f.name.as_str()).collect();
+    assert_eq!(names, ["sign(I)*max(|I|-I_lim,0)"]);
+    let limit = law.current_limit.expect("the limit is reported");
+    assert!(within(limit, i_sat, 0.03), "{limit} A vs {i_sat}");
+    let f = &law.functions[0];
+    assert!(f.q025 <= -1.0 && -1.0 <= f.q975, "{}", law.equation);
+    assert!(d.unexplained.is_none(), "{:?}", d.unexplained);
+}
+
+/// A speed sensor's offset (ω read as ω + b; speed_offset-600002, a held input, of `--effects
+/// speed_offset --per-effect 6 --seed-base 600000`): the library holds the current's offset and
+/// not the speed's, and a load torque, the current's offset and the torque constant stood in
+/// for it together. The law in the reading of ω, the constant alone, its 95% interval
+/// holding b, printed as the constant it is.
+#[test]
+fn a_speed_sensor_s_offset_is_discovered_as_a_constant_in_what_is_read() {
+    let (problem, answer) = fixture("speed_offset-600002");
+    let b = truth_value(&answer, "b");
+    let d = diagnose(&problem);
+    assert_eq!(d.selected_set, ["law"], "no library term beside it");
+    let law = d.discovered.expect("a law is discovered");
+    assert_eq!(law.balance, "measurement:omega");
+    let names: Vec<&str> = law.functions.iter().map(|f| f.name.as_str()).collect();
+    assert_eq!(names, ["1"]);
+    let f = &law.functions[0];
+    assert!(f.q025 <= b && b <= f.q975, "{} vs {b}", law.equation);
+    assert!(
+        law.equation.starts_with("measured ω += "),
+        "{}",
+        law.equation
+    );
+    assert!(!law.equation.contains('·'), "{}", law.equation);
 }
 
 /// Where a library term holds the effect, the law the model as given asks for is that term
