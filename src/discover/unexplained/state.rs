@@ -42,8 +42,8 @@ use nalgebra::DMatrix;
 use crate::error::Error;
 use crate::forward::ForwardModel;
 use crate::motor::dictionary::{
-    self, CONSTANT, COS_THETA, CURRENT_LIMIT, FUNCTIONS, N_FUNCTIONS, Point, SIN_THETA, STRIBECK,
-    Shapes,
+    self, CONSTANT, COS_THETA, CURRENT_LIMIT, FUNCTIONS, N_FUNCTIONS, ODE_BALANCES, Point,
+    SIN_THETA, STRIBECK, Shapes,
 };
 use crate::motor::terms::Law;
 use crate::motor::{ActiveTerm, MotorModel, Term, VoltageInput};
@@ -272,13 +272,13 @@ pub(super) fn fingerprints(
         .filter(|&f| f != STRIBECK && f != SIN_THETA && f != COS_THETA && f != CURRENT_LIMIT)
         .filter(|f| !dictionary::PERIODIC.contains(f))
         // Only what a balance is offered: the others' columns would be solved for nothing.
-        .filter(|&f| (0..2).any(|b| dictionary::offered_in(f, b)))
+        .filter(|&f| (0..ODE_BALANCES).any(|b| dictionary::offered_in(f, b)))
         .collect();
     let mut columns: Vec<Column> = Vec::new();
     // Per block, its functions; its columns are balance-major (torque's, then voltage's).
     let mut blocks: Vec<(Vec<usize>, DMatrix<f64>)> = Vec::new();
     let mut add = |functions: Vec<usize>, shape: Shape| -> Result<(), Error> {
-        let keys: Vec<usize> = (0..2)
+        let keys: Vec<usize> = (0..ODE_BALANCES)
             .flat_map(|b| functions.iter().map(move |&f| b * N_FUNCTIONS + f))
             .collect();
         let b = law_columns(fit, ctx, &law, shape, &keys)?;
@@ -313,7 +313,7 @@ pub(super) fn fingerprints(
         add(vec![CURRENT_LIMIT], Shape::CurrentLimit(i))?;
     }
     let mut out = Vec::new();
-    for balance in 0..2 {
+    for balance in 0..ODE_BALANCES {
         // The balance's column of each regressor, in `columns`' order.
         let mut b = DMatrix::zeros(ctx.m(), columns.len());
         let mut j = 0;
