@@ -38,6 +38,15 @@ fn diagnose(problem: &Problem) -> Diagnosis {
     d
 }
 
+/// The law `d` discovered, asserted to be in `balance` with exactly the functions `names`.
+fn discovered_in(d: &Diagnosis, balance: &str, names: &[&str]) -> Discovered {
+    let law = d.discovered.clone().expect("a law is discovered");
+    assert_eq!(law.balance, balance, "{}", law.equation);
+    let found: Vec<&str> = law.functions.iter().map(|f| f.name.as_str()).collect();
+    assert_eq!(found, names, "{}", law.equation);
+    law
+}
+
 fn within(estimate: f64, truth: f64, share: f64) -> bool {
     (estimate / truth - 1.0).abs() <= share
 }
@@ -49,10 +58,7 @@ fn friction_growing_with_the_current_is_discovered_as_its_law() {
     let (problem, answer) = fixture("load_friction-510012");
     let mu = truth_value(&answer, "mu");
     let d = diagnose(&problem);
-    let law = d.discovered.expect("a law is discovered");
-    assert_eq!(law.balance, "torque");
-    let names: Vec<&str> = law.functions.iter().map(|f| f.name.as_str()).collect();
-    assert_eq!(names, ["sign(omega)*|I|"]);
+    let law = discovered_in(&d, "torque", &["sign(omega)*|I|"]);
     let f = &law.functions[0];
     assert!(
         within(f.coefficient, -mu, 0.3),
@@ -147,10 +153,7 @@ fn a_supply_sagging_with_the_charge_is_discovered_in_place_of_library_terms_stan
     let (problem, answer) = fixture("sagging_supply-510013");
     let kappa = truth_value(&answer, "kappa");
     let d = diagnose(&problem);
-    let law = d.discovered.expect("a law is discovered");
-    assert_eq!(law.balance, "voltage");
-    let names: Vec<&str> = law.functions.iter().map(|f| f.name.as_str()).collect();
-    assert_eq!(names, ["U*charge"]);
+    let law = discovered_in(&d, "voltage", &["U*charge"]);
     let f = &law.functions[0];
     assert!(
         within(f.coefficient, -kappa, 0.3),
@@ -204,10 +207,7 @@ fn a_drives_current_limit_is_discovered_with_its_level() {
     let (problem, answer) = fixture("current_limit-560011");
     let i_max = truth_value(&answer, "i_max");
     let d = diagnose(&problem);
-    let law = d.discovered.expect("a law is discovered");
-    assert_eq!(law.balance, "voltage");
-    let names: Vec<&str> = law.functions.iter().map(|f| f.name.as_str()).collect();
-    assert_eq!(names, ["sign(I)*max(|I|-I_lim,0)"]);
+    let law = discovered_in(&d, "voltage", &["sign(I)*max(|I|-I_lim,0)"]);
     let limit = law.current_limit.expect("the limit is reported");
     assert!(within(limit, i_max, 0.05), "{limit} A vs {i_max}");
     assert!(law.functions[0].coefficient < 0.0, "{}", law.equation);
@@ -229,10 +229,7 @@ fn a_return_spring_is_discovered_as_a_law_of_the_angle() {
     let (problem, answer) = fixture("return_spring-570008");
     let k = truth_value(&answer, "k");
     let d = diagnose(&problem);
-    let law = d.discovered.expect("a law is discovered");
-    assert_eq!(law.balance, "torque");
-    let names: Vec<&str> = law.functions.iter().map(|f| f.name.as_str()).collect();
-    assert_eq!(names, ["theta"]);
+    let law = discovered_in(&d, "torque", &["theta"]);
     let f = &law.functions[0];
     assert!(f.q025 <= -k && -k <= f.q975, "{} vs −{k}", law.equation);
 }
@@ -247,10 +244,7 @@ fn a_leak_on_the_current_sensor_is_discovered_as_a_law_of_what_is_read() {
     let g = truth_value(&answer, "g");
     let d = diagnose(&problem);
     assert_eq!(d.selected_set, ["law"], "no library term beside it");
-    let law = d.discovered.expect("a law is discovered");
-    assert_eq!(law.balance, "measurement:I");
-    let names: Vec<&str> = law.functions.iter().map(|f| f.name.as_str()).collect();
-    assert_eq!(names, ["U"]);
+    let law = discovered_in(&d, "measurement:I", &["U"]);
     let f = &law.functions[0];
     assert!(f.q025 <= g && g <= f.q975, "{} vs {g}", law.equation);
     assert!(law.equation.starts_with("measured I"), "{}", law.equation);
@@ -268,10 +262,7 @@ fn a_current_reading_clipped_at_its_range_is_discovered_as_a_clip_not_a_drive_li
     let (problem, answer) = fixture("current_clip-590001");
     let i_sat = truth_value(&answer, "i_sat");
     let d = diagnose(&problem);
-    let law = d.discovered.expect("a law is discovered");
-    assert_eq!(law.balance, "measurement:I");
-    let names: Vec<&str> = law.functions.iter().map(|f| f.name.as_str()).collect();
-    assert_eq!(names, ["sign(I)*max(|I|-I_lim,0)"]);
+    let law = discovered_in(&d, "measurement:I", &["sign(I)*max(|I|-I_lim,0)"]);
     let limit = law.current_limit.expect("the limit is reported");
     assert!(within(limit, i_sat, 0.03), "{limit} A vs {i_sat}");
     let f = &law.functions[0];
@@ -290,10 +281,7 @@ fn a_speed_sensor_s_offset_is_discovered_as_a_constant_in_what_is_read() {
     let b = truth_value(&answer, "b");
     let d = diagnose(&problem);
     assert_eq!(d.selected_set, ["law"], "no library term beside it");
-    let law = d.discovered.expect("a law is discovered");
-    assert_eq!(law.balance, "measurement:omega");
-    let names: Vec<&str> = law.functions.iter().map(|f| f.name.as_str()).collect();
-    assert_eq!(names, ["1"]);
+    let law = discovered_in(&d, "measurement:omega", &["1"]);
     let f = &law.functions[0];
     assert!(f.q025 <= b && b <= f.q975, "{} vs {b}", law.equation);
     assert!(

@@ -38,8 +38,9 @@ pub const FUNCTIONS: [&str; 23] = [
 pub const N_FUNCTIONS: usize = FUNCTIONS.len();
 
 /// The balances a law adds to, in the order of the law's parameters: the two of the ODE (J dω/dt,
-/// L dI/dt), then what is read of each measured channel (a sensor that also reads the input,
-/// the other channel, or its own nonlinearly: measured I += Σ c·f).
+/// L dI/dt), then what is read of each measured channel (measured I += Σ c·f: a sensor that
+/// also reads the input, reads its own channel nonlinearly, clips, or reads with an offset).
+/// The coefficients' units are the law's (`terms::Law`'s parameters).
 pub const BALANCES: [&str; 4] = ["torque", "voltage", "measurement:I", "measurement:omega"];
 
 /// How many of [`BALANCES`] are the ODE's; those after them add to a measured channel (the
@@ -221,27 +222,6 @@ pub fn typical_size(f: usize, m: &Magnitudes) -> f64 {
         // The angle the record's speed turns over it.
         THETA => m.speed * m.duration,
         _ => 1.0,
-    }
-}
-
-/// The unit of a coefficient of function `f` in the torque balance and in the voltage balance.
-pub fn units(f: usize) -> (&'static str, &'static str) {
-    match f {
-        0 => ("N·m·s/rad", "V·s/rad"),
-        1 => ("N·m·s²/rad²", "V·s²/rad²"),
-        2 => ("N·m·s³/rad³", "V·s³/rad³"),
-        5 | 6 | 8 | CURRENT_LIMIT => ("N·m/A", "Ω"),
-        7 => ("N·m/A²", "V/A²"),
-        9 => ("N·m/V", "1"),
-        CHARGE => ("N·m/(A·s)", "V/(A·s)"),
-        U_CHARGE => ("N·m/(V·A·s)", "1/(A·s)"),
-        HEAT => ("N·m/J", "V/J"),
-        OMEGA_HEAT => ("N·m·s/(rad·J)", "V·s/(rad·J)"),
-        I_HEAT => ("N·m/(A·J)", "Ω/J"),
-        TIME => ("N·m/s", "V/s"),
-        THETA => ("N·m/rad", "V/rad"),
-        CONSTANT => ("N·m", "V"),
-        _ => ("N·m", "V"),
     }
 }
 

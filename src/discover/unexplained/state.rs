@@ -46,7 +46,7 @@ use crate::motor::dictionary::{
     SIN_THETA, STRIBECK, Shapes,
 };
 use crate::motor::terms::Law;
-use crate::motor::{ActiveTerm, MotorModel, Term, VoltageInput};
+use crate::motor::{ActiveTerm, MotorModel, Term};
 
 use super::super::candidate::Candidate;
 use super::super::settings::EVIDENCE_THRESHOLD;
@@ -379,10 +379,7 @@ fn measurement_fingerprints(
             _ => None,
         })
         .unwrap_or_default();
-    let input_varies = match &model.input {
-        VoltageInput::Constant => false,
-        VoltageInput::Held { values, .. } => values.iter().any(|&v| v != values[0]),
-    };
+    let input_varies = !model.input.breakpoints().is_empty();
     let mut out = Vec::new();
     for (c, channel) in ctx.channels.iter().enumerate() {
         if Some(c) != current && Some(c) != speed {

@@ -1,9 +1,9 @@
 //! A law of the state found beyond the library: Σ c·f(state, input) added to the torque balance
 //! (J dω/dt), to the voltage balance (L dI/dt), or to what is read of a channel (measured I or
 //! ω: a sensor's law, evaluated on the channels as the sensors before it read them), the
-//! functions f from the fixed dictionary of `motor::dictionary`. Every (balance, function) pair is a parameter (default 0: absent), but
-//! only the pairs the law lists are active: evaluated, written to the model file and
-//! calibrated. Three states follow the record for the functions that need them: the charge
+//! functions f from the fixed dictionary of `motor::dictionary`. Every (balance, function) pair
+//! is a parameter (default 0: absent), but only the pairs the law lists are active: evaluated,
+//! written to the model file and calibrated. Three states follow the record for the functions that need them: the charge
 //! ∫|I|dt, the heat ∫R·I²dt and the angle θ = ∫ω dt, each integrated only when a listed function
 //! reads it (a state left constant leaves the integrator's steps as they were).
 //!
