@@ -98,7 +98,8 @@ enum Effect {
     /// `--effects return_spring`.
     ReturnSpring { k: f64 },
     /// A misaligned coupling passing the torque unevenly, k times per revolution: a share
-    /// ε·sin(kθ + φ) of the motor's torque c_g·I lost. `--effects load_ripple`.
+    /// ε·sin(kθ + φ) of the motor's torque c_g·I lost (its truth: the law in I·sin(kθ) and
+    /// I·cos(kθ), coefficients −ε·c_g·cos φ and −ε·c_g·sin φ). `--effects load_ripple`.
     LoadRipple { eps: f64, k: u32, phase: f64 },
     /// A leakage path beside the winding, on the supply side of the current sensor: the
     /// measured current is I + U·g. `--effects leakage_current`.
@@ -563,7 +564,7 @@ fn expected(e: &Effect) -> String {
         Effect::AmplifierSaturation { .. } => r#"{"kind": "state", "balance": "voltage", "functions": ["U"]}"#.into(),
         Effect::SpeedOffset { .. } => r#"{"kind": "state", "balance": "measurement:omega", "functions": ["1"]}"#.into(),
         Effect::SpeedQuantization { .. } => r#"{"kind": "state", "balance": "measurement:omega", "functions": ["omega"]}"#.into(),
-        Effect::LoadRipple { k, .. } => format!(r#"{{"kind": "state", "balance": "torque", "functions": ["sin(k*theta)", "cos(k*theta)"], "k": {k}}}"#),
+        Effect::LoadRipple { k, .. } => format!(r#"{{"kind": "state", "balance": "torque", "functions": ["I*sin(k*theta)", "I*cos(k*theta)"], "k": {k}}}"#),
     }
 }
 

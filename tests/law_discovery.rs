@@ -234,6 +234,33 @@ fn a_return_spring_is_discovered_as_a_law_of_the_angle() {
     assert!(f.q025 <= -k && -k <= f.q975, "{} vs −{k}", law.equation);
 }
 
+/// A share of the motor's torque lost once per revolution, ε·sin(θ + φ)·c_g·I (a coupling that
+/// passes the torque unevenly; load_ripple-570003 of `--effects
+/// inductance_saturation,return_spring,load_ripple --per-effect 4 --seed-base 570000`): a
+/// ripple that grows with the current. Before the current's ripple was in the dictionary the
+/// law was sin θ, cos θ, the intervals missing the truth's phase. The law in the torque balance
+/// in I·sin θ and I·cos θ, at k = 1, each interval holding the truth's −ε·c_g·cos φ and
+/// −ε·c_g·sin φ.
+#[test]
+fn a_ripple_growing_with_the_current_is_discovered_in_the_current_times_the_angle() {
+    let (problem, answer) = fixture("load_ripple-570003");
+    let (eps, phase) = (truth_value(&answer, "eps"), truth_value(&answer, "phase"));
+    let c_g = problem.model.motor.get(MotorParam::TorqueConstant);
+    let d = diagnose(&problem);
+    let law = discovered_in(&d, "torque", &["I*sin(k*theta)", "I*cos(k*theta)"]);
+    assert_eq!(law.k, Some(truth_value(&answer, "k")));
+    let truths = [-eps * c_g * phase.cos(), -eps * c_g * phase.sin()];
+    for (f, truth) in law.functions.iter().zip(truths) {
+        assert!(
+            f.q025 <= truth && truth <= f.q975,
+            "{}: {truth} outside [{}, {}]",
+            f.name,
+            f.q025,
+            f.q975
+        );
+    }
+}
+
 /// A leak on the supply side of the current sensor (what is read is I + g·U;
 /// leakage_current-580010, a held input, of `--effects leakage_current,tacho_nonlinearity,backlash
 /// --per-effect 4 --seed-base 580000`): three library terms stood in for it before the law could

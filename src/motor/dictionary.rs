@@ -8,7 +8,7 @@
 use super::{Magnitudes, Scalar};
 
 /// The functions, in the order of the law's parameters (within each balance).
-pub const FUNCTIONS: [&str; 23] = [
+pub const FUNCTIONS: [&str; 25] = [
     "omega",
     "omega*|omega|",
     "omega^3",
@@ -32,6 +32,8 @@ pub const FUNCTIONS: [&str; 23] = [
     "sign(I)*max(|I|-I_lim,0)",
     "theta",
     "1",
+    "I*sin(k*theta)",
+    "I*cos(k*theta)",
 ];
 
 /// How many functions the dictionary holds.
@@ -81,6 +83,30 @@ pub const THETA: usize = 21;
 /// library's `current_offset`). In a balance it would be a constant load or voltage, which
 /// the library's `load_torque` and `voltage_drop` hold, so it is offered in what is read only.
 pub const CONSTANT: usize = 22;
+/// The current times the angle's ripple: a torque constant that varies with the angle, c_g·I
+/// passed on as c_g·(1 + ε·sin(k·θ + φ))·I (a coupling that passes the torque unevenly over a
+/// turn, a rotor whose flux is uneven). The ripple then grows with the load's current and
+/// vanishes at no load, where sin(k·θ) alone (a cogging torque, an eccentric mass) does not;
+/// before it was offered such a ripple was named in sin(k·θ), cos(k·θ) with σ left above the
+/// noise (load_ripple-570003).
+pub const I_SIN_THETA: usize = 23;
+pub const I_COS_THETA: usize = 24;
+/// The functions of the angle's harmonic k, which are tried at each k together.
+pub const ANGLE_RIPPLES: [usize; 4] = [SIN_THETA, COS_THETA, I_SIN_THETA, I_COS_THETA];
+/// The two ripples of the angle, each a sine and a cosine (the ripple's phase is the record's):
+/// the angle's own (a torque the load's current does not scale: cogging, an eccentric mass)
+/// and the current's. A fingerprint or a law holds one of them in a balance, not both: over a
+/// revolution a record's current changes slowly against the ripple, so c·sin(k·θ) and
+/// c'·I·sin(k·θ) are near-collinear, and a law with both holds one ripple twice, its
+/// coefficients trading against each other (on eccentric-510006 a law with both had each of
+/// the current's intervals spanning zero; on cogging-530007 the current's sine joined the
+/// angle's pair the same way).
+pub const RIPPLES: [[usize; 2]; 2] = [[SIN_THETA, COS_THETA], [I_SIN_THETA, I_COS_THETA]];
+
+/// Which of [`RIPPLES`] function `f` belongs to, if either.
+pub fn ripple_of(f: usize) -> Option<usize> {
+    RIPPLES.iter().position(|r| r.contains(&f))
+}
 
 /// Whether the state fingerprint offers function `f` in balance `b` (0 torque, 1 voltage): the
 /// supply scaled by its charge acts where the supply does, in the voltage balance; in the
@@ -102,12 +128,14 @@ pub const CONSTANT: usize = 22;
 ///
 /// The angle is offered in the torque balance only: a torque that winds up with the turn is a
 /// spring's; a voltage that does has no physics in a motor behind it (the angle's ripples,
-/// sin(k·θ) and cos(k·θ), are a commutator's in either).
+/// sin(k·θ) and cos(k·θ), are a commutator's in either). So is the current's ripple: a torque
+/// constant that varies with the angle (in the voltage balance its back-EMF would be ω's
+/// ripple, not I's).
 pub fn offered_in(f: usize, b: usize) -> bool {
     match f {
         OMEGA_HEAT | I_HEAT => false,
         U_CHARGE | CURRENT_LIMIT => b == 1,
-        THETA => b == 0,
+        THETA | I_SIN_THETA | I_COS_THETA => b == 0,
         CONSTANT => b >= ODE_BALANCES,
         _ => true,
     }
@@ -118,7 +146,7 @@ pub fn state_of(function: usize) -> Option<usize> {
     match function {
         CHARGE | U_CHARGE => Some(0),
         HEAT | OMEGA_HEAT | I_HEAT => Some(1),
-        SIN_THETA | COS_THETA | THETA => Some(2),
+        SIN_THETA | COS_THETA | THETA | I_SIN_THETA | I_COS_THETA => Some(2),
         _ => None,
     }
 }
@@ -194,6 +222,8 @@ pub fn value<D: Scalar>(f: usize, x: &Point<D>, s: &Shapes) -> D {
         }
         THETA => x.theta,
         CONSTANT => D::from(1.0),
+        I_SIN_THETA => x.current * (x.theta * s.harmonic).sin(),
+        I_COS_THETA => x.current * (x.theta * s.harmonic).cos(),
         _ => unreachable!("the dictionary has {N_FUNCTIONS} functions"),
     }
 }
@@ -205,7 +235,7 @@ pub fn typical_size(f: usize, m: &Magnitudes) -> f64 {
         0 => m.speed,
         1 => m.speed * m.speed,
         2 => m.speed.powi(3),
-        5 | 6 | 8 => m.current,
+        5 | 6 | 8 | I_SIN_THETA | I_COS_THETA => m.current,
         // What a limit lets through: a drive's current loop holds the current within a percent
         // or so of its limit, so the excess is a hundredth of the current scale, and the
         // coefficient (the loop's gain, in Ω) may be many times R.
@@ -300,6 +330,39 @@ mod tests {
         assert!((value(COS_THETA, &x, &shapes(6.0)) - 1.8f64.cos()).abs() < 1e-12);
         assert_eq!(FUNCTIONS[SIN_THETA], "sin(k*theta)");
         assert_eq!(FUNCTIONS[COS_THETA], "cos(k*theta)");
+    }
+
+    /// The current's ripple is the current times the angle's, at the same harmonic, and a torque's
+    /// alone: a torque constant that varies over a turn.
+    #[test]
+    fn the_current_s_ripple_is_the_current_times_the_angle_s_in_the_torque_balance() {
+        let x = Point {
+            t: 0.0,
+            current: -12.5,
+            speed: 1.0,
+            voltage: 1.0,
+            charge: 0.0,
+            heat: 0.0,
+            theta: 0.7,
+        };
+        let shapes = Shapes {
+            omega_smooth: 1.0,
+            omega_s: 50.0,
+            frequency: 50.0,
+            harmonic: 3.0,
+            current_limit: 100.0,
+        };
+        for (ripple, angle) in [(I_SIN_THETA, SIN_THETA), (I_COS_THETA, COS_THETA)] {
+            assert_eq!(
+                value(ripple, &x, &shapes),
+                -12.5 * value(angle, &x, &shapes)
+            );
+            assert_eq!(state_of(ripple), Some(2), "it needs θ integrated");
+            let offered: Vec<bool> = (0..BALANCES.len()).map(|b| offered_in(ripple, b)).collect();
+            assert_eq!(offered, [true, false, false, false]);
+        }
+        assert_eq!(FUNCTIONS[I_SIN_THETA], "I*sin(k*theta)");
+        assert_eq!(index_of("torque:I*cos(k*theta)"), Ok(I_COS_THETA));
     }
 
     /// Where each function may enter a fingerprint: the angle in the torque balance only (a

@@ -42,8 +42,8 @@ use nalgebra::DMatrix;
 use crate::error::Error;
 use crate::forward::ForwardModel;
 use crate::motor::dictionary::{
-    self, CONSTANT, COS_THETA, CURRENT_LIMIT, FUNCTIONS, N_FUNCTIONS, ODE_BALANCES, Point,
-    SIN_THETA, STRIBECK, Shapes,
+    self, ANGLE_RIPPLES, CONSTANT, CURRENT_LIMIT, FUNCTIONS, N_FUNCTIONS, ODE_BALANCES, Point,
+    RIPPLES, STRIBECK, Shapes, ripple_of,
 };
 use crate::motor::terms::Law;
 use crate::motor::{ActiveTerm, MotorModel, Term};
@@ -239,7 +239,7 @@ pub(super) fn fingerprints(
         _ => STRIBECK_SHARES.iter().map(|s| s * speed).collect(),
     };
     let harmonics: Vec<f64> = match &own {
-        Some(l) if holds(SIN_THETA) || holds(COS_THETA) => vec![l.shapes.harmonic],
+        Some(l) if ANGLE_RIPPLES.iter().any(|&f| holds(f)) => vec![l.shapes.harmonic],
         _ => {
             let interval = (ctx.times[ctx.n - 1] - ctx.times[0]) / (ctx.n - 1).max(1) as f64;
             HARMONICS
@@ -269,7 +269,7 @@ pub(super) fn fingerprints(
         }
     };
     let plain: Vec<usize> = (0..N_FUNCTIONS)
-        .filter(|&f| f != STRIBECK && f != SIN_THETA && f != COS_THETA && f != CURRENT_LIMIT)
+        .filter(|&f| f != STRIBECK && f != CURRENT_LIMIT && !ANGLE_RIPPLES.contains(&f))
         .filter(|f| !dictionary::PERIODIC.contains(f))
         // Only what a balance is offered: the others' columns would be solved for nothing.
         .filter(|&f| (0..ODE_BALANCES).any(|b| dictionary::offered_in(f, b)))
@@ -307,7 +307,7 @@ pub(super) fn fingerprints(
         add(vec![STRIBECK], Shape::StribeckSpeed(w))?;
     }
     for k in harmonics {
-        add(vec![SIN_THETA, COS_THETA], Shape::Harmonic(k))?;
+        add(ANGLE_RIPPLES.to_vec(), Shape::Harmonic(k))?;
     }
     for &i in &current_limits {
         add(vec![CURRENT_LIMIT], Shape::CurrentLimit(i))?;
@@ -325,7 +325,18 @@ pub(super) fn fingerprints(
         }
         let b_tilde = ctx.projector.residualize(&b);
         let name = dictionary::BALANCES[balance];
-        let offered = |f: usize| dictionary::offered_in(f, balance);
+        // A balance whose law holds one of the angle's ripples is not offered the other: the
+        // two are near, and the second would hold the first's ripple twice.
+        let own_ripple = own.as_ref().and_then(|l| {
+            l.active
+                .iter()
+                .filter(|&&k| k / N_FUNCTIONS == balance)
+                .find_map(|&k| ripple_of(k % N_FUNCTIONS))
+        });
+        let offered = |f: usize| {
+            dictionary::offered_in(f, balance)
+                && ripple_of(f).is_none_or(|r| own_ripple.is_none_or(|o| o == r))
+        };
         let first = select(ctx, &columns, &b_tilde, name, shift, offered);
         // A ripple in the angle on its own as well, where the selection took another
         // function first: on a record that spins up from rest the ripple's net early push is
@@ -338,7 +349,7 @@ pub(super) fn fingerprints(
         let add_ripple = first.as_ref().is_some_and(|e| !took_angle(e));
         out.extend(first);
         if add_ripple {
-            let angle = |f: usize| (f == SIN_THETA || f == COS_THETA) && offered(f);
+            let angle = |f: usize| ANGLE_RIPPLES.contains(&f) && offered(f);
             out.extend(select(ctx, &columns, &b_tilde, name, shift, angle));
         }
     }
@@ -463,6 +474,8 @@ fn select(
         let stribeck = chosen.iter().find_map(|&j| columns[j].omega_s);
         let harmonic = chosen.iter().find_map(|&j| columns[j].harmonic);
         let limit = chosen.iter().find_map(|&j| columns[j].current_limit);
+        // And one of the angle's two ripples (`dictionary::RIPPLES`).
+        let ripple = chosen.iter().find_map(|&j| ripple_of(columns[j].function));
         let open: Vec<usize> = (0..columns.len())
             .filter(|j| !chosen.contains(j))
             .filter(|&j| stribeck.is_none() || columns[j].omega_s.is_none())
@@ -470,19 +483,25 @@ fn select(
             .filter(|&j| {
                 harmonic.is_none() || columns[j].harmonic.is_none_or(|k| Some(k) == harmonic)
             })
+            .filter(|&j| {
+                ripple.is_none() || ripple_of(columns[j].function).is_none_or(|r| Some(r) == ripple)
+            })
             .filter(|&j| offered(columns[j].function))
             .collect();
-        // The moves: each open column, and each harmonic's sin and cos together.
+        // The moves: each open column, and each harmonic's sin and cos together (of the
+        // angle, and of the angle times the current): a ripple's phase is the record's.
         let mut moves: Vec<Vec<usize>> = open.iter().map(|&j| vec![j]).collect();
-        for &j in open.iter().filter(|&&j| columns[j].function == SIN_THETA) {
-            let k = columns[j].harmonic;
-            let cos = open
-                .iter()
-                .find(|&&c| columns[c].function == COS_THETA && columns[c].harmonic == k);
-            if let Some(&c) = cos
-                && chosen.len() + 2 <= MAX_FUNCTIONS
-            {
-                moves.push(vec![j, c]);
+        for [sin, cos] in RIPPLES {
+            for &j in open.iter().filter(|&&j| columns[j].function == sin) {
+                let k = columns[j].harmonic;
+                let pair = open
+                    .iter()
+                    .find(|&&c| columns[c].function == cos && columns[c].harmonic == k);
+                if let Some(&c) = pair
+                    && chosen.len() + 2 <= MAX_FUNCTIONS
+                {
+                    moves.push(vec![j, c]);
+                }
             }
         }
         if moves.is_empty() {

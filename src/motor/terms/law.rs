@@ -128,6 +128,8 @@ impl PhysicsTerm for Law {
         20 "sign(I)*max(|I|-I_lim,0)" "N·m/A" "Ω" "1" "rad/(s·A)",
         21 "theta" "N·m/rad" "V/rad" "A/rad" "1/s",
         22 "1" "N·m" "V" "A" "rad/s",
+        23 "I*sin(k*theta)" "N·m/A" "Ω" "1" "rad/(s·A)",
+        24 "I*cos(k*theta)" "N·m/A" "Ω" "1" "rad/(s·A)",
     );
     const SETTINGS: &'static [TermSetting] = &[
         TermSetting {
