@@ -13,7 +13,7 @@ use crate::diagnostics::{KHAT_GOOD, autocovariance};
 use crate::error::Error;
 use crate::optimize::{MapSettings, find_map};
 use crate::pipeline::{
-    RunOutput, RunSettings, SamplerKind, default_warmup, finish_run, run_sampler,
+    MapSearch, RunOutput, RunSettings, SamplerKind, default_warmup, finish_run, run_sampler,
 };
 use crate::sampler::driver::chain_rng;
 use crate::sampler::proposal::LaplaceProposal;
@@ -143,6 +143,8 @@ fn importance_or_sampler(
         sampler: SamplerKind::LaplaceIs,
         fallback: true,
         fallback_above: KHAT_GOOD,
+        // The fit starts at a candidate's MAP, found by the ranking's search.
+        map_search: MapSearch::Ranking,
         // The run's warm-up is NUTS's; importance sampling's is its own recentring (BM2 fits
         // only: see `pipeline::importance`).
         chain: crate::sampler::ChainSettings {

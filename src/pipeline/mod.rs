@@ -42,7 +42,7 @@ pub use crate::sampler::PhaseCost;
 pub use cost::{RunCost, ratio_2sf};
 pub use importance::IS_SHAPE;
 pub use settings::{
-    LAPLACE_TARGET_ACCEPT, LAPLACE_WARMUP, MetricAdaptation, RunSettings, SamplerKind,
+    LAPLACE_TARGET_ACCEPT, LAPLACE_WARMUP, MapSearch, MetricAdaptation, RunSettings, SamplerKind,
     default_warmup,
 };
 
@@ -90,8 +90,16 @@ impl RunOutput {
 
 /// The MAP from the posterior's own starting point.
 pub fn map_estimate<P: Fittable>(posterior: &mut P) -> Result<MapEstimate, Error> {
+    map_estimate_with(posterior, &MapSettings::default())
+}
+
+/// As [`map_estimate`], by the search `settings`.
+pub fn map_estimate_with<P: Fittable>(
+    posterior: &mut P,
+    settings: &MapSettings,
+) -> Result<MapEstimate, Error> {
     let start = posterior.initial_point()?;
-    Ok(find_map(posterior, &start, &MapSettings::default())?)
+    Ok(find_map(posterior, &start, settings)?)
 }
 
 /// Initial points: the MAP plus N(0, (c²) H⁻¹) jitter, on a random stream of its own so the
@@ -264,7 +272,7 @@ pub fn run_sampler<P: Fittable>(
     // The MAP on a counting copy: the same computation (the posterior's cache changes speed,
     // never values), with its evaluations counted toward the whole cost.
     let mut counted = Counted::new(posterior.clone());
-    let map = map_estimate(&mut counted)?;
+    let map = map_estimate_with(&mut counted, &settings.map_search.settings())?;
     let inits = initial_points(
         &mut counted,
         &map,
