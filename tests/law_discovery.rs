@@ -13,7 +13,7 @@ mod beyond;
 
 use beyond::{fixture, truth_value};
 
-use motorcal::discover::{Diagnosis, DiscoverSettings, Discovered, discover};
+use motorcal::discover::{Diagnosis, DiscoverSettings, Discovered, DiscoveredFunction, discover};
 use motorcal::motor::MotorParam;
 use motorcal::study::cases::{CaseOptions, make_case};
 use motorcal::study::{InputProfile, Problem};
@@ -45,6 +45,11 @@ fn discovered_in(d: &Diagnosis, balance: &str, names: &[&str]) -> Discovered {
     let found: Vec<&str> = law.functions.iter().map(|f| f.name.as_str()).collect();
     assert_eq!(found, names, "{}", law.equation);
     law
+}
+
+/// Whether a discovered function's 95% interval holds `truth`.
+fn holds(f: &DiscoveredFunction, truth: f64) -> bool {
+    f.q025 <= truth && truth <= f.q975
 }
 
 fn within(estimate: f64, truth: f64, share: f64) -> bool {
@@ -231,7 +236,7 @@ fn a_return_spring_is_discovered_as_a_law_of_the_angle() {
     let d = diagnose(&problem);
     let law = discovered_in(&d, "torque", &["theta"]);
     let f = &law.functions[0];
-    assert!(f.q025 <= -k && -k <= f.q975, "{} vs −{k}", law.equation);
+    assert!(holds(f, -k), "{} vs −{k}", law.equation);
 }
 
 /// A share of the motor's torque lost once per revolution, ε·sin(θ + φ)·c_g·I (a coupling that
@@ -252,7 +257,7 @@ fn a_ripple_growing_with_the_current_is_discovered_in_the_current_times_the_angl
     let truths = [-eps * c_g * phase.cos(), -eps * c_g * phase.sin()];
     for (f, truth) in law.functions.iter().zip(truths) {
         assert!(
-            f.q025 <= truth && truth <= f.q975,
+            holds(f, truth),
             "{}: {truth} outside [{}, {}]",
             f.name,
             f.q025,
@@ -273,7 +278,7 @@ fn a_leak_on_the_current_sensor_is_discovered_as_a_law_of_what_is_read() {
     assert_eq!(d.selected_set, ["law"], "no library term beside it");
     let law = discovered_in(&d, "measurement:I", &["U"]);
     let f = &law.functions[0];
-    assert!(f.q025 <= g && g <= f.q975, "{} vs {g}", law.equation);
+    assert!(holds(f, g), "{} vs {g}", law.equation);
     assert!(law.equation.starts_with("measured I"), "{}", law.equation);
 }
 
@@ -293,7 +298,7 @@ fn a_current_reading_clipped_at_its_range_is_discovered_as_a_clip_not_a_drive_li
     let limit = law.current_limit.expect("the limit is reported");
     assert!(within(limit, i_sat, 0.03), "{limit} A vs {i_sat}");
     let f = &law.functions[0];
-    assert!(f.q025 <= -1.0 && -1.0 <= f.q975, "{}", law.equation);
+    assert!(holds(f, -1.0), "{}", law.equation);
     assert!(d.unexplained.is_none(), "{:?}", d.unexplained);
 }
 
@@ -310,7 +315,7 @@ fn a_speed_sensor_s_offset_is_discovered_as_a_constant_in_what_is_read() {
     assert_eq!(d.selected_set, ["law"], "no library term beside it");
     let law = discovered_in(&d, "measurement:omega", &["1"]);
     let f = &law.functions[0];
-    assert!(f.q025 <= b && b <= f.q975, "{} vs {b}", law.equation);
+    assert!(holds(f, b), "{} vs {b}", law.equation);
     assert!(
         law.equation.starts_with("measured ω += "),
         "{}",

@@ -20,8 +20,8 @@ use serde::Serialize;
 use crate::error::Error;
 use crate::motor::Term;
 use crate::motor::dictionary::{
-    self, ANGLE_RIPPLES, BALANCES, CURRENT_LIMIT, FUNCTIONS, N_FUNCTIONS, ODE_BALANCES, PERIODIC,
-    RIPPLES, STRIBECK, ripple_of,
+    self, BALANCES, CURRENT_LIMIT, FUNCTIONS, N_FUNCTIONS, ODE_BALANCES, PERIODIC, RIPPLES,
+    STRIBECK, ripple_of,
 };
 use crate::motor::terms::Law;
 use crate::parameter::ParamId;
@@ -260,7 +260,8 @@ fn extended(held: &Law, more: &Law) -> Law {
     if !has(held, &[STRIBECK]) && has(more, &[STRIBECK]) {
         law.shapes.omega_s = more.shapes.omega_s;
     }
-    if !has(held, &ANGLE_RIPPLES) && has(more, &ANGLE_RIPPLES) {
+    let ripples = RIPPLES.concat();
+    if !has(held, &ripples) && has(more, &ripples) {
         law.shapes.harmonic = more.shapes.harmonic;
     }
     if !has(held, &[CURRENT_LIMIT]) && has(more, &[CURRENT_LIMIT]) {
@@ -382,9 +383,10 @@ pub fn discovered(fit: &Candidate, gained: f64) -> Option<Discovered> {
     }
     let holds = |f: usize| functions.iter().any(|g| g.name == FUNCTIONS[f]);
     let omega_s = holds(STRIBECK).then_some(law.shapes.omega_s);
-    let k = ANGLE_RIPPLES
-        .iter()
-        .any(|&f| holds(f))
+    let k = RIPPLES
+        .concat()
+        .into_iter()
+        .any(holds)
         .then_some(law.shapes.harmonic);
     let frequency_hz = PERIODIC
         .iter()

@@ -91,8 +91,6 @@ pub const CONSTANT: usize = 22;
 /// the wrong variables, and on load_ripple-570009 an oscillation of +19.4 nats left after it.
 pub const I_SIN_THETA: usize = 23;
 pub const I_COS_THETA: usize = 24;
-/// The functions of the angle's harmonic k, which are tried at each k together.
-pub const ANGLE_RIPPLES: [usize; 4] = [SIN_THETA, COS_THETA, I_SIN_THETA, I_COS_THETA];
 /// The two ripples of the angle, each a sine and a cosine (the ripple's phase is the record's):
 /// the angle's own (a torque the load's current does not scale: cogging, an eccentric mass)
 /// and the current's. A fingerprint or a law holds one of them in a balance, not both: over a
@@ -101,9 +99,10 @@ pub const ANGLE_RIPPLES: [usize; 4] = [SIN_THETA, COS_THETA, I_SIN_THETA, I_COS_
 /// coefficients trading against each other (on eccentric-510006 a law with both had each of
 /// the current's intervals spanning zero; on cogging-530007 the current's sine joined the
 /// angle's pair the same way).
+/// All four are tried at each harmonic k together.
 pub const RIPPLES: [[usize; 2]; 2] = [[SIN_THETA, COS_THETA], [I_SIN_THETA, I_COS_THETA]];
 
-/// Which of [`RIPPLES`] function `f` belongs to, if either.
+/// Which of [`RIPPLES`] function `f` belongs to, if either (none: `f` reads no harmonic).
 pub fn ripple_of(f: usize) -> Option<usize> {
     RIPPLES.iter().position(|r| r.contains(&f))
 }
@@ -222,8 +221,8 @@ pub fn value<D: Scalar>(f: usize, x: &Point<D>, s: &Shapes) -> D {
         }
         THETA => x.theta,
         CONSTANT => D::from(1.0),
-        I_SIN_THETA => x.current * (x.theta * s.harmonic).sin(),
-        I_COS_THETA => x.current * (x.theta * s.harmonic).cos(),
+        I_SIN_THETA => x.current * value(SIN_THETA, x, s),
+        I_COS_THETA => x.current * value(COS_THETA, x, s),
         _ => unreachable!("the dictionary has {N_FUNCTIONS} functions"),
     }
 }

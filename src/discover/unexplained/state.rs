@@ -42,8 +42,8 @@ use nalgebra::DMatrix;
 use crate::error::Error;
 use crate::forward::ForwardModel;
 use crate::motor::dictionary::{
-    self, ANGLE_RIPPLES, CONSTANT, CURRENT_LIMIT, FUNCTIONS, N_FUNCTIONS, ODE_BALANCES, Point,
-    RIPPLES, STRIBECK, Shapes, ripple_of,
+    self, CONSTANT, CURRENT_LIMIT, FUNCTIONS, N_FUNCTIONS, ODE_BALANCES, Point, RIPPLES, STRIBECK,
+    Shapes, ripple_of,
 };
 use crate::motor::terms::Law;
 use crate::motor::{ActiveTerm, MotorModel, Term};
@@ -239,7 +239,7 @@ pub(super) fn fingerprints(
         _ => STRIBECK_SHARES.iter().map(|s| s * speed).collect(),
     };
     let harmonics: Vec<f64> = match &own {
-        Some(l) if ANGLE_RIPPLES.iter().any(|&f| holds(f)) => vec![l.shapes.harmonic],
+        Some(l) if RIPPLES.concat().into_iter().any(holds) => vec![l.shapes.harmonic],
         _ => {
             let interval = (ctx.times[ctx.n - 1] - ctx.times[0]) / (ctx.n - 1).max(1) as f64;
             HARMONICS
@@ -269,7 +269,7 @@ pub(super) fn fingerprints(
         }
     };
     let plain: Vec<usize> = (0..N_FUNCTIONS)
-        .filter(|&f| f != STRIBECK && f != CURRENT_LIMIT && !ANGLE_RIPPLES.contains(&f))
+        .filter(|&f| f != STRIBECK && f != CURRENT_LIMIT && ripple_of(f).is_none())
         .filter(|f| !dictionary::PERIODIC.contains(f))
         // Only what a balance is offered: the others' columns would be solved for nothing.
         .filter(|&f| (0..ODE_BALANCES).any(|b| dictionary::offered_in(f, b)))
@@ -307,7 +307,7 @@ pub(super) fn fingerprints(
         add(vec![STRIBECK], Shape::StribeckSpeed(w))?;
     }
     for k in harmonics {
-        add(ANGLE_RIPPLES.to_vec(), Shape::Harmonic(k))?;
+        add(RIPPLES.concat(), Shape::Harmonic(k))?;
     }
     for &i in &current_limits {
         add(vec![CURRENT_LIMIT], Shape::CurrentLimit(i))?;
@@ -349,7 +349,7 @@ pub(super) fn fingerprints(
         let add_ripple = first.as_ref().is_some_and(|e| !took_angle(e));
         out.extend(first);
         if add_ripple {
-            let angle = |f: usize| ANGLE_RIPPLES.contains(&f) && offered(f);
+            let angle = |f: usize| ripple_of(f).is_some() && offered(f);
             out.extend(select(ctx, &columns, &b_tilde, name, shift, angle));
         }
     }
