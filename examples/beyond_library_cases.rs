@@ -564,7 +564,13 @@ fn expected(e: &Effect) -> String {
         Effect::AmplifierSaturation { .. } => r#"{"kind": "state", "balance": "voltage", "functions": ["U"]}"#.into(),
         Effect::SpeedOffset { .. } => r#"{"kind": "state", "balance": "measurement:omega", "functions": ["1"]}"#.into(),
         Effect::SpeedQuantization { .. } => r#"{"kind": "state", "balance": "measurement:omega", "functions": ["omega"]}"#.into(),
-        Effect::LoadRipple { k, .. } => format!(r#"{{"kind": "state", "balance": "torque", "functions": ["I*sin(k*theta)", "I*cos(k*theta)"], "k": {k}}}"#),
+        // The torque lost, ε·sin(kθ + φ)·c_g·I, as the law's two coefficients (c_g the nominal's,
+        // which the truth keeps).
+        Effect::LoadRipple { eps, k, phase } => format!(
+            r#"{{"kind": "state", "balance": "torque", "functions": ["I*sin(k*theta)", "I*cos(k*theta)"], "k": {k}, "coefficients": [{}, {}]}}"#,
+            -eps * NOMINAL.c_g * phase.cos(),
+            -eps * NOMINAL.c_g * phase.sin()
+        ),
     }
 }
 
