@@ -2,7 +2,7 @@
 //! the independent RK4 integrator of `examples/beyond_library_cases.rs` (seeds 510006, 510012,
 //! 510013 and 510015 of `--per-effect 2 --seed-base 510000`; supply ripples 560004 and 560012 of
 //! `--effects flux_saturation,thermal_magnet,current_limit,supply_ripple --per-effect 3
-//! --seed-base 560000`, as is current_limit-560011; a return spring, a leaking and a clipping
+//! --seed-base 560000`, as are supply_ripple-560008 and current_limit-560011; a return spring, a leaking and a clipping
 //! current sensor and a speed sensor's offset, named at their tests; the answer beside each recording), leave a state
 //! fingerprint or a
 //! forced oscillation; the law term written from it is fitted, taken by the ranking's threshold,
@@ -201,6 +201,32 @@ fn a_supply_ripple_is_discovered_as_a_periodic_law_in_the_voltage_balance() {
         );
         assert!(d.unexplained.is_none(), "{case}: {:?}", d.unexplained);
     }
+}
+
+/// The same ripple on an input that steps and reverses (supply_ripple-560008 of the same set,
+/// input −24, 8, 24 V): the ripple is a share of what the drive applies, U·(1 + ε·cos 2πft),
+/// and follows the input's level. A law in sin and cos(2πft) holds it at one level only: it
+/// was taken at 73.38 Hz and left +56.8 nats. The law in U·sin and U·cos(2πft) in the voltage
+/// balance, its frequency searched through the ODE: within 0.5% of f, the cosine's 95%
+/// interval holding ε and the sine's zero (the truth's phase), nothing left.
+#[test]
+fn a_supply_ripple_on_a_stepping_input_follows_the_input() {
+    let (problem, answer) = fixture("supply_ripple-560008");
+    let (eps, f) = (truth_value(&answer, "eps"), truth_value(&answer, "f"));
+    let d = diagnose(&problem);
+    let law = discovered_in(&d, "voltage", &["U*sin(2*pi*f*t)", "U*cos(2*pi*f*t)"]);
+    let found = law.frequency_hz.expect("the law's frequency is reported");
+    assert!(within(found, f, 0.005), "{found} Hz vs {f}");
+    for (function, truth) in law.functions.iter().zip([0.0, eps]) {
+        assert!(
+            holds(function, truth),
+            "{}: {truth} outside [{}, {}]",
+            function.name,
+            function.q025,
+            function.q975
+        );
+    }
+    assert!(d.unexplained.is_none(), "{:?}", d.unexplained);
 }
 
 /// A drive's current limit, a loop that takes G·(|I| − I_max) volts off above I_max (no term

@@ -54,6 +54,7 @@ pub use as_given::AsGiven;
 pub use fingerprint::{EquationTerm, Fingerprint, equation_with, with_shapes};
 use oscillation::Oscillation;
 pub use oscillation::{frequency_search_cost, lowest_frequency_over};
+pub use regression::golden_max;
 use regression::{Explained, Projector, explain};
 pub use spans::Span;
 use spans::spans;

@@ -270,7 +270,7 @@ pub(super) fn fingerprints(
     };
     let plain: Vec<usize> = (0..N_FUNCTIONS)
         .filter(|&f| f != STRIBECK && f != CURRENT_LIMIT && ripple_of(f).is_none())
-        .filter(|f| !dictionary::PERIODIC.contains(f))
+        .filter(|f| !dictionary::PERIODIC.contains(f) && !dictionary::SUPPLY_RIPPLE.contains(f))
         // Only what a balance is offered: the others' columns would be solved for nothing.
         .filter(|&f| (0..ODE_BALANCES).any(|b| dictionary::offered_in(f, b)))
         .collect();

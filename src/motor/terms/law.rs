@@ -130,6 +130,8 @@ impl PhysicsTerm for Law {
         22 "1" "N·m" "V" "A" "rad/s",
         23 "I*sin(k*theta)" "N·m/A" "Ω" "1" "rad/(s·A)",
         24 "I*cos(k*theta)" "N·m/A" "Ω" "1" "rad/(s·A)",
+        25 "U*sin(2*pi*f*t)" "N·m/V" "1" "S" "rad/(s·V)",
+        26 "U*cos(2*pi*f*t)" "N·m/V" "1" "S" "rad/(s·V)",
     );
     const SETTINGS: &'static [TermSetting] = &[
         TermSetting {
