@@ -379,6 +379,39 @@ mod tests {
         assert_eq!(index_of("torque:I*cos(k*theta)"), Ok(I_COS_THETA));
     }
 
+    /// The supply's ripple is the input times the periodic functions of time, at the same
+    /// frequency, and a voltage's alone: a share of what the drive applies.
+    #[test]
+    fn the_supply_s_ripple_is_the_input_times_the_periodic_functions_in_the_voltage_balance() {
+        let x = Point {
+            t: 0.0123,
+            current: 3.0,
+            speed: 1.0,
+            voltage: -8.0,
+            charge: 0.0,
+            heat: 0.0,
+            theta: 0.0,
+        };
+        let shapes = Shapes {
+            omega_smooth: 1.0,
+            omega_s: 50.0,
+            frequency: 74.8,
+            harmonic: 1.0,
+            current_limit: 100.0,
+        };
+        for (ripple, plain) in SUPPLY_RIPPLE.into_iter().zip(PERIODIC) {
+            assert_eq!(value(ripple, &x, &shapes), -8.0 * value(plain, &x, &shapes));
+            assert_eq!(state_of(ripple), None);
+            let offered: Vec<bool> = (0..BALANCES.len()).map(|b| offered_in(ripple, b)).collect();
+            assert_eq!(offered, [false, true, false, false]);
+        }
+        assert_eq!(FUNCTIONS[U_SIN_FT], "U*sin(2*pi*f*t)");
+        assert_eq!(
+            index_of("voltage:U*cos(2*pi*f*t)"),
+            Ok(N_FUNCTIONS + U_COS_FT)
+        );
+    }
+
     /// Where each function may enter a fingerprint: the angle in the torque balance only (a
     /// spring's), the constant in what is read only (in a balance it is a library term's).
     #[test]
