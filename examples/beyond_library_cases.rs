@@ -17,7 +17,9 @@
 //! `current_limit`, `supply_ripple` (a stand-in for the private holdout's effects not named),
 //! and a second such set made after the first was worked on: `inductance_saturation`,
 //! `return_spring`, `load_ripple`; then `leakage_current`, `tacho_nonlinearity`, `backlash`;
-//! a third, `current_clip`, `amplifier_saturation`, `speed_quantization`, and `speed_offset`.
+//! a third, `current_clip`, `amplifier_saturation`, `speed_quantization`, and `speed_offset`;
+//! a fourth, `mains_pickup`, `bearing_defect`, `tacho_ripple` (the last two on slow records,
+//! `--volts 2`, where their ripples are sampled).
 //!
 //! cargo run --release --example beyond_library_cases -- [--out DIR] [--per-effect 3]
 //!     [--seed-base 510000] [--min-nats 20] [--max-nats 300] [--effects a,b,…] [--volts 24]
@@ -122,6 +124,16 @@ enum Effect {
     /// A speed sensor's offset: ω read as ω + b (the library holds the current's offset, not
     /// the speed's). `--effects speed_offset`.
     SpeedOffset { b: f64 },
+    /// Mains pickup on the current sensor's cable: a·sin(2πft + φ) added to what is read of
+    /// I, f 50 or 60 Hz. `--effects mains_pickup`.
+    MainsPickup { a: f64, f: f64, phase: f64 },
+    /// A bearing's defect: a torque −a·sin(k·θ + φ) at a k that is not a whole number of
+    /// periods per revolution (a ball-pass frequency over the shaft's, 2.2–5.8).
+    /// `--effects bearing_defect`.
+    BearingDefect { a: f64, k: f64, phase: f64 },
+    /// A tachogenerator's commutator ripple: ω read as ω·(1 + ε·sin(k·θ + φ)), k 1–3.
+    /// `--effects tacho_ripple`.
+    TachoRipple { eps: f64, k: u32, phase: f64 },
 }
 
 impl Effect {
@@ -196,6 +208,21 @@ impl Effect {
             "amplifier_saturation" => Effect::AmplifierSaturation { u_max: 20.0 },
             "speed_quantization" => Effect::SpeedQuantization { q: 5.0 },
             "speed_offset" => Effect::SpeedOffset { b: 5.0 },
+            "mains_pickup" => Effect::MainsPickup {
+                a: 1.0,
+                f: if rng.random_bool(0.5) { 50.0 } else { 60.0 },
+                phase: rng.random_range(0.0..2.0 * PI),
+            },
+            "bearing_defect" => Effect::BearingDefect {
+                a: 1e-3,
+                k: rng.random_range(2.2..5.8),
+                phase: rng.random_range(0.0..2.0 * PI),
+            },
+            "tacho_ripple" => Effect::TachoRipple {
+                eps: 1e-2,
+                k: rng.random_range(1..=3u32),
+                phase: rng.random_range(0.0..2.0 * PI),
+            },
             other => panic!("unknown effect {other}; known: {:?}", Effect::NAMES),
         }
     }
@@ -227,6 +254,8 @@ impl Effect {
             Effect::AmplifierSaturation { u_max } => 1.0 / u_max,
             Effect::SpeedQuantization { q } => q,
             Effect::SpeedOffset { b } => b,
+            Effect::MainsPickup { a, .. } | Effect::BearingDefect { a, .. } => a,
+            Effect::TachoRipple { eps, .. } => eps,
         }
     }
 
@@ -256,6 +285,8 @@ impl Effect {
             Effect::AmplifierSaturation { u_max } => *u_max = 1.0 / s,
             Effect::SpeedQuantization { q } => *q = s,
             Effect::SpeedOffset { b } => *b = s,
+            Effect::MainsPickup { a, .. } | Effect::BearingDefect { a, .. } => *a = s,
+            Effect::TachoRipple { eps, .. } => *eps = s,
         }
         e
     }
@@ -282,6 +313,9 @@ impl Effect {
             Effect::AmplifierSaturation { .. } => 0.25,
             Effect::SpeedQuantization { .. } => 240.0,
             Effect::SpeedOffset { .. } => 100.0,
+            // A pickup of at most 50 A; a ripple of at most half the speed.
+            Effect::MainsPickup { .. } => 50.0,
+            Effect::TachoRipple { .. } => 0.5,
             _ => 1.0,
         }
     }
@@ -404,13 +438,20 @@ fn rhs(
             dx[2] = w;
         }
         Some(&Effect::AmplifierSaturation { u_max }) => u = u.clamp(-u_max, u_max),
+        Some(&Effect::BearingDefect { a, k, phase }) => {
+            torque -= a * (k * x[2] + phase).sin();
+            dx[2] = w;
+        }
+        // The angle, which the tacho's ripple reads.
+        Some(Effect::TachoRipple { .. }) => dx[2] = w,
         // These act on what is measured (`measured`, `simulate`), not on the motor.
         Some(
             Effect::LeakageCurrent { .. }
             | Effect::TachoNonlinearity { .. }
             | Effect::CurrentClip { .. }
             | Effect::SpeedQuantization { .. }
-            | Effect::SpeedOffset { .. },
+            | Effect::SpeedOffset { .. }
+            | Effect::MainsPickup { .. },
         )
         | None => {}
     }
@@ -437,6 +478,9 @@ fn measured(e: Option<&Effect>, x: &[f64; 4]) -> [f64; 2] {
         Some(&Effect::CurrentClip { i_sat }) => [x[0].clamp(-i_sat, i_sat), x[1]],
         Some(&Effect::SpeedQuantization { q }) => [x[0], q * (x[1] / q).round()],
         Some(&Effect::SpeedOffset { b }) => [x[0], x[1] + b],
+        Some(&Effect::TachoRipple { eps, k, phase }) => {
+            [x[0], x[1] * (1.0 + eps * (k as f64 * x[2] + phase).sin())]
+        }
         _ => [x[0], x[1]],
     }
 }
@@ -463,6 +507,9 @@ fn simulate(m: &Motor, e: Option<&Effect>, input: &Input, times: &[f64]) -> Vec<
         let mut y = measured(e, &x);
         if let Some(&Effect::LeakageCurrent { g }) = e {
             y[0] += g * input.at(t, times);
+        }
+        if let Some(&Effect::MainsPickup { a, f, phase }) = e {
+            y[0] += a * (2.0 * PI * f * t + phase).sin();
         }
         out.push(y);
     }
@@ -564,6 +611,12 @@ fn expected(e: &Effect) -> String {
         Effect::AmplifierSaturation { .. } => r#"{"kind": "state", "balance": "voltage", "functions": ["U"]}"#.into(),
         Effect::SpeedOffset { .. } => r#"{"kind": "state", "balance": "measurement:omega", "functions": ["1"]}"#.into(),
         Effect::SpeedQuantization { .. } => r#"{"kind": "state", "balance": "measurement:omega", "functions": ["omega"]}"#.into(),
+        // What is read of I, a sinusoid that runs on whatever the motor does.
+        Effect::MainsPickup { f, .. } => format!(r#"{{"kind": "oscillation", "frequency_hz": {f}, "channel": "I", "ringing": false}}"#),
+        // The angle's ripple at a k between the dictionary's grid points.
+        Effect::BearingDefect { k, .. } => format!(r#"{{"kind": "state", "balance": "torque", "functions": ["sin(k*theta)", "cos(k*theta)"], "k": {k}}}"#),
+        // ω·sin(k·θ) is in no dictionary: what is read of ω, in the angle.
+        Effect::TachoRipple { k, .. } => format!(r#"{{"kind": "state", "balance": "measurement:omega", "functions": ["omega*sin(k*theta)", "omega*cos(k*theta)"], "k": {k}}}"#),
         // The torque lost, ε·sin(kθ + φ)·c_g·I, as the law's two coefficients (c_g the nominal's,
         // which the truth keeps).
         Effect::LoadRipple { eps, k, phase } => format!(
