@@ -2,10 +2,12 @@
 //! `input_delay` (τ), a lag names `sensor_lag` on its channel (τ), a resonance that rings after
 //! the input steps names `compliant_coupling` (f_r and ζ; the load's share from several
 //! starts); an oscillation that runs on regardless of the input (a forced one: a pulsing load,
-//! a rectified supply's ripple) names the `law` in sin and cos(2πft) at its frequency, in either
-//! balance, and where the input changes level the supply's ripple, those times U; a state or drift fingerprint names the `law` with its functions. The dynamic terms
-//! are also ranked with the library (started from the same estimates, `unexplained::starts`);
-//! this is the second chance for what the selected model still leaves.
+//! a rectified supply's ripple, mains pickup on a sensor) names the `law` in sin and cos(2πft)
+//! at its frequency, in either balance and in what is read of its channel, and where the input
+//! changes level the supply's ripple, those times U; a state or drift fingerprint names the
+//! `law` with its functions. The dynamic terms are also ranked with the library (started from
+//! the same estimates, `unexplained::starts`); this is the second chance for what the selected
+//! model still leaves.
 //!
 //! Each is tried beside the selected terms and alone (a library term selected for a delay
 //! absorbs part of it, and beside the delay is then dead weight), scored as every candidate is
@@ -56,10 +58,12 @@ pub fn named_terms(problem: &Problem, fingerprint: &Fingerprint) -> Vec<NamedTer
             ringing: false,
             sensor: false,
             frequencies,
+            channel,
             ..
         } => (0..ODE_BALANCES)
             .map(|b| (b, PERIODIC))
             .chain(input_varies(problem).then_some((1, SUPPLY_RIPPLE)))
+            .chain(reading_of(channel).map(|b| (b, PERIODIC)))
             .filter_map(|(b, functions)| {
                 forced_law(problem, b, functions, *frequency_hz, *frequencies)
             })
@@ -105,6 +109,14 @@ fn ripple_twin(fingerprint: &Fingerprint) -> Option<Fingerprint> {
         swapped = true;
     }
     swapped.then_some(twin)
+}
+
+/// The balance of what is read of `channel` (a pickup on its sensor's cable: mains hum on a
+/// current reading runs on whatever the motor does, as a supply's ripple does, and differs
+/// from it only by what the ripple would drive through the motor into the other channel).
+fn reading_of(channel: &str) -> Option<usize> {
+    let balance = format!("measurement:{channel}");
+    BALANCES.iter().position(|b| *b == balance)
 }
 
 /// Whether any of `problem`'s records is driven by an input that changes level: there a
