@@ -23,7 +23,7 @@ use crate::error::Error;
 use crate::motor::Term;
 use crate::motor::dictionary::{
     self, BALANCES, CURRENT_LIMIT, FUNCTIONS, N_FUNCTIONS, ODE_BALANCES, PERIODIC, RIPPLES,
-    STRIBECK, SUPPLY_RIPPLE, ripple_of,
+    STRIBECK, SUPPLY_RIPPLE, reads_harmonic, ripple_of,
 };
 use crate::motor::terms::Law;
 use crate::parameter::ParamId;
@@ -355,7 +355,7 @@ fn extended(held: &Law, more: &Law) -> Law {
     if !has(held, &[STRIBECK]) && has(more, &[STRIBECK]) {
         law.shapes.omega_s = more.shapes.omega_s;
     }
-    let ripples = RIPPLES.concat();
+    let ripples: Vec<usize> = (0..N_FUNCTIONS).filter(|&f| reads_harmonic(f)).collect();
     if !has(held, &ripples) && has(more, &ripples) {
         law.shapes.harmonic = more.shapes.harmonic;
     }
@@ -478,10 +478,8 @@ pub fn discovered(fit: &Candidate, gained: f64) -> Option<Discovered> {
     }
     let holds = |f: usize| functions.iter().any(|g| g.name == FUNCTIONS[f]);
     let omega_s = holds(STRIBECK).then_some(law.shapes.omega_s);
-    let k = RIPPLES
-        .concat()
-        .into_iter()
-        .any(holds)
+    let k = (0..N_FUNCTIONS)
+        .any(|f| reads_harmonic(f) && holds(f))
         .then_some(law.shapes.harmonic);
     let frequency_hz = PERIODIC
         .iter()

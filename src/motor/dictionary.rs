@@ -8,7 +8,7 @@
 use super::{Magnitudes, Scalar};
 
 /// The functions, in the order of the law's parameters (within each balance).
-pub const FUNCTIONS: [&str; 27] = [
+pub const FUNCTIONS: [&str; 29] = [
     "omega",
     "omega*|omega|",
     "omega^3",
@@ -36,6 +36,8 @@ pub const FUNCTIONS: [&str; 27] = [
     "I*cos(k*theta)",
     "U*sin(2*pi*f*t)",
     "U*cos(2*pi*f*t)",
+    "omega*sin(k*theta)",
+    "omega*cos(k*theta)",
 ];
 
 /// How many functions the dictionary holds.
@@ -114,9 +116,25 @@ pub const U_SIN_FT: usize = 25;
 pub const U_COS_FT: usize = 26;
 pub const SUPPLY_RIPPLE: [usize; 2] = [U_SIN_FT, U_COS_FT];
 
-/// Which of [`RIPPLES`] function `f` belongs to, if either (none: `f` reads no harmonic).
+/// The speed times the angle's ripple, what is read of ω: a tachogenerator's commutator
+/// ripple or an encoder mounted off-centre reads ω·(1 + ε·sin(k·θ + φ)), a ripple that grows
+/// with the speed and is in the reading, not the motor. Before it was offered such a ripple on
+/// a slow record was named a sinusoid in time read on ω, or a torque ripple in the angle
+/// (tacho_ripple-620002 to -620008).
+pub const OMEGA_SIN_THETA: usize = 27;
+pub const OMEGA_COS_THETA: usize = 28;
+pub const READING_RIPPLE: [usize; 2] = [OMEGA_SIN_THETA, OMEGA_COS_THETA];
+
+/// Which of [`RIPPLES`] function `f` belongs to, if either (none: `f` is not a ripple of the
+/// balances).
 pub fn ripple_of(f: usize) -> Option<usize> {
     RIPPLES.iter().position(|r| r.contains(&f))
+}
+
+/// Whether function `f` reads the angle's harmonic k: a ripple of the balances or of what is
+/// read of ω.
+pub fn reads_harmonic(f: usize) -> bool {
+    ripple_of(f).is_some() || READING_RIPPLE.contains(&f)
 }
 
 /// Whether the state fingerprint offers function `f` in balance `b` (0 torque, 1 voltage): the
@@ -142,12 +160,13 @@ pub fn ripple_of(f: usize) -> Option<usize> {
 /// sin(k·θ) and cos(k·θ), are a commutator's in either). So is the current's ripple: a torque
 /// constant that varies with the angle (in the voltage balance its back-EMF would be ω's
 /// ripple, not I's). The supply's ripple is offered in the voltage balance only, where the
-/// supply acts.
+/// supply acts. The speed's ripple is offered in what is read of ω only.
 pub fn offered_in(f: usize, b: usize) -> bool {
     match f {
         OMEGA_HEAT | I_HEAT => false,
         U_CHARGE | CURRENT_LIMIT | U_SIN_FT | U_COS_FT => b == 1,
         THETA | I_SIN_THETA | I_COS_THETA => b == 0,
+        OMEGA_SIN_THETA | OMEGA_COS_THETA => b == 3,
         CONSTANT => b >= ODE_BALANCES,
         _ => true,
     }
@@ -158,7 +177,8 @@ pub fn state_of(function: usize) -> Option<usize> {
     match function {
         CHARGE | U_CHARGE => Some(0),
         HEAT | OMEGA_HEAT | I_HEAT => Some(1),
-        SIN_THETA | COS_THETA | THETA | I_SIN_THETA | I_COS_THETA => Some(2),
+        SIN_THETA | COS_THETA | THETA | I_SIN_THETA | I_COS_THETA | OMEGA_SIN_THETA
+        | OMEGA_COS_THETA => Some(2),
         _ => None,
     }
 }
@@ -238,6 +258,8 @@ pub fn value<D: Scalar>(f: usize, x: &Point<D>, s: &Shapes) -> D {
         I_COS_THETA => x.current * value(COS_THETA, x, s),
         U_SIN_FT => x.voltage * phase.sin(),
         U_COS_FT => x.voltage * phase.cos(),
+        OMEGA_SIN_THETA => x.speed * value(SIN_THETA, x, s),
+        OMEGA_COS_THETA => x.speed * value(COS_THETA, x, s),
         _ => unreachable!("the dictionary has {N_FUNCTIONS} functions"),
     }
 }
@@ -246,7 +268,7 @@ pub fn value<D: Scalar>(f: usize, x: &Point<D>, s: &Shapes) -> D {
 /// a tenth of its balance's scale divided by it.
 pub fn typical_size(f: usize, m: &Magnitudes) -> f64 {
     match f {
-        0 => m.speed,
+        0 | OMEGA_SIN_THETA | OMEGA_COS_THETA => m.speed,
         1 => m.speed * m.speed,
         2 => m.speed.powi(3),
         5 | 6 | 8 | I_SIN_THETA | I_COS_THETA => m.current,
@@ -409,6 +431,42 @@ mod tests {
         assert_eq!(
             index_of("voltage:U*cos(2*pi*f*t)"),
             Ok(N_FUNCTIONS + U_COS_FT)
+        );
+    }
+
+    /// The speed's ripple is the speed times the angle's, at the same harmonic, and what is
+    /// read of ω alone: a tachometer's ripple.
+    #[test]
+    fn the_speed_s_ripple_is_the_speed_times_the_angle_s_in_what_is_read_of_omega() {
+        let x = Point {
+            t: 0.0,
+            current: 3.0,
+            speed: 180.0,
+            voltage: 2.0,
+            charge: 0.0,
+            heat: 0.0,
+            theta: 40.3,
+        };
+        let shapes = Shapes {
+            omega_smooth: 1.0,
+            omega_s: 50.0,
+            frequency: 50.0,
+            harmonic: 2.0,
+            current_limit: 100.0,
+        };
+        for (ripple, angle) in READING_RIPPLE.into_iter().zip([SIN_THETA, COS_THETA]) {
+            assert_eq!(
+                value(ripple, &x, &shapes),
+                180.0 * value(angle, &x, &shapes)
+            );
+            assert_eq!(state_of(ripple), Some(2), "it needs θ integrated");
+            assert!(reads_harmonic(ripple) && ripple_of(ripple).is_none());
+            let offered: Vec<bool> = (0..BALANCES.len()).map(|b| offered_in(ripple, b)).collect();
+            assert_eq!(offered, [false, false, false, true]);
+        }
+        assert_eq!(
+            index_of("measurement:omega:omega*sin(k*theta)"),
+            Ok(3 * N_FUNCTIONS + OMEGA_SIN_THETA)
         );
     }
 

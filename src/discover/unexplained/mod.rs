@@ -32,6 +32,7 @@
 mod as_given;
 mod fingerprint;
 mod oscillation;
+mod reading;
 mod regression;
 mod resonance;
 mod spans;

@@ -42,8 +42,7 @@ use nalgebra::DMatrix;
 use crate::error::Error;
 use crate::forward::ForwardModel;
 use crate::motor::dictionary::{
-    self, CONSTANT, CURRENT_LIMIT, FUNCTIONS, N_FUNCTIONS, ODE_BALANCES, Point, RIPPLES, STRIBECK,
-    Shapes, ripple_of,
+    self, CURRENT_LIMIT, FUNCTIONS, N_FUNCTIONS, ODE_BALANCES, RIPPLES, STRIBECK, Shapes, ripple_of,
 };
 use crate::motor::terms::Law;
 use crate::motor::{ActiveTerm, MotorModel, Term};
@@ -82,39 +81,13 @@ fn sampled_ripple(k: f64, speed: f64, interval: f64) -> bool {
     k * speed * interval < std::f64::consts::PI
 }
 
-/// The functions a measured channel is offered in (`measurement:I`, `measurement:omega`): a
-/// sensor that reads the input besides its own channel (a leakage path on the supply side of a
-/// current sensor reads I + U/R_p), one that reads its own channel nonlinearly, one that
-/// drifts, one that reads the speed with an offset. The speed's own linear gain is the
-/// library's `speed_gain`, not offered on ω, nor is the current's offset, the library's
-/// `current_offset`, offered on I. Where the input is held constant, U is the constant on ω:
-/// a speed sensor's zero is the simpler reading of it, and U is not offered there.
-///
-/// Not the other channel (crosstalk), although it was at first: what a channel reads of the
-/// other is, to first order, what a lag of it reads. A filtered ω is ω − τ·dω/dt, and dω/dt
-/// follows I; offered, `measured ω += −0.115·I` took a resonant speed sensor's place
-/// (resonant_sensor-510014: 3.9 nats over `sensor_lag`, whose fit is where the ringing is
-/// looked for, so the ringing went unreported). Crosstalk is left to laws written by hand.
-/// With five columns on ω the first needs ½·ln N + ln 5 + 2 = 7.1 nats at N = 1002: as the
-/// balances' selection reasons, about 5·P(χ²₁ > 14.2) ≈ 0.1% per channel on a null record (on
-/// I, with the current limit's six, ln 10: 7.8 nats).
-const MEASURED: [usize; 8] = [0, 1, 2, 5, 7, 9, 12, CONSTANT];
-/// The input, offered where it varies.
-const INPUT: usize = 9;
-/// Those of them that read the speed (`omega`, `omega*|omega|`, `omega^3`), and the current
-/// (`I`, `I*|I|`): offered only on that channel's own reading.
-const READS_SPEED: [usize; 3] = [0, 1, 2];
-const READS_CURRENT: [usize; 2] = [5, 7];
-/// The speed itself read on the speed's channel: a gain, the library's `speed_gain`.
-const SPEED: usize = 0;
-
 /// A column of the regression: a function (dictionary index) and the shape it has, the
 /// Stribeck speed or the angle's harmonic.
-struct Column {
-    function: usize,
-    omega_s: Option<f64>,
-    harmonic: Option<f64>,
-    current_limit: Option<f64>,
+pub(super) struct Column {
+    pub function: usize,
+    pub omega_s: Option<f64>,
+    pub harmonic: Option<f64>,
+    pub current_limit: Option<f64>,
 }
 
 /// How a block of columns shapes the law it is evaluated on.
@@ -239,7 +212,9 @@ pub(super) fn fingerprints(
         _ => STRIBECK_SHARES.iter().map(|s| s * speed).collect(),
     };
     let harmonics: Vec<f64> = match &own {
-        Some(l) if RIPPLES.concat().into_iter().any(holds) => vec![l.shapes.harmonic],
+        Some(l) if (0..N_FUNCTIONS).any(|f| dictionary::reads_harmonic(f) && holds(f)) => {
+            vec![l.shapes.harmonic]
+        }
         _ => {
             let interval = (ctx.times[ctx.n - 1] - ctx.times[0]) / (ctx.n - 1).max(1) as f64;
             HARMONICS
@@ -306,7 +281,7 @@ pub(super) fn fingerprints(
     for w in stribeck_speeds {
         add(vec![STRIBECK], Shape::StribeckSpeed(w))?;
     }
-    for k in harmonics {
+    for &k in &harmonics {
         add(RIPPLES.concat(), Shape::Harmonic(k))?;
     }
     for &i in &current_limits {
@@ -353,113 +328,19 @@ pub(super) fn fingerprints(
             out.extend(select(ctx, &columns, &b_tilde, name, shift, angle));
         }
     }
-    out.extend(measurement_fingerprints(fit, ctx, &current_limits, shift));
+    out.extend(super::reading::fingerprints(
+        fit,
+        ctx,
+        &current_limits,
+        &harmonics,
+        shift,
+    ));
     Ok(out)
-}
-
-/// The state fingerprints of the measured channels: the residual of a channel regressed on
-/// functions of the predicted state and the input in that channel alone (a measurement adds
-/// to what is read, not to a balance: the column is the function itself, no solve needed),
-/// selected as a balance's are; the law's measurement balances hold them, so a fingerprint
-/// here names a law as a balance's does (`named`). The current is also offered beyond each of
-/// `current_limits` (`sign(I)*max(|I|-I_lim,0)`): a reading clipped at its sensor's or its
-/// converter's range is I less that, which in the voltage balance would be a drive's limit
-/// acting on the motor — the two told apart by ω, which the clip leaves alone.
-fn measurement_fingerprints(
-    fit: &Candidate,
-    ctx: &Context,
-    current_limits: &[f64],
-    shift: f64,
-) -> Vec<Evidence> {
-    let model = fit.posterior.forward(0).model();
-    // The functions offered read no shape but the current limit's; the dictionary's defaults
-    // stand for the others.
-    let Some(Term::Law(law)) = Term::named("law") else {
-        return Vec::new();
-    };
-    let index = |name: &str| ctx.channels.iter().position(|c| c == name);
-    let (current, speed) = (index("I"), index("omega"));
-    // What the model's own law reads already. Its columns are in the model's Jacobian, but
-    // evaluated here on the predicted reading (which the law itself has amended: a clipped
-    // current's hinge is near zero) they would not be projected out.
-    let held: Vec<usize> = model
-        .terms()
-        .iter()
-        .find_map(|t| match &t.term {
-            Term::Law(l) => Some(l.active.clone()),
-            _ => None,
-        })
-        .unwrap_or_default();
-    let input_varies = !model.input.breakpoints().is_empty();
-    let mut out = Vec::new();
-    for (c, channel) in ctx.channels.iter().enumerate() {
-        if Some(c) != current && Some(c) != speed {
-            continue;
-        }
-        let balance = format!("measurement:{channel}");
-        let Some(b) = dictionary::BALANCES.iter().position(|n| *n == balance) else {
-            continue;
-        };
-        let fresh = |f: usize| !held.contains(&(b * N_FUNCTIONS + f));
-        let functions: Vec<usize> = MEASURED
-            .into_iter()
-            .filter(|&f| !(Some(c) == speed && f == SPEED))
-            .filter(|f| Some(c) == speed || !READS_SPEED.contains(f))
-            .filter(|f| Some(c) == current || !READS_CURRENT.contains(f))
-            .filter(|&f| fresh(f))
-            .filter(|&f| f != CONSTANT || Some(c) == speed)
-            .filter(|&f| f != INPUT || Some(c) != speed || input_varies)
-            .collect();
-        let mut columns: Vec<Column> = functions
-            .iter()
-            .map(|&function| Column {
-                function,
-                omega_s: None,
-                harmonic: None,
-                current_limit: None,
-            })
-            .collect();
-        if Some(c) == current && fresh(CURRENT_LIMIT) {
-            columns.extend(current_limits.iter().map(|&i| Column {
-                function: CURRENT_LIMIT,
-                omega_s: None,
-                harmonic: None,
-                current_limit: Some(i),
-            }));
-        }
-        let shapes: Vec<Shapes> = columns
-            .iter()
-            .map(|column| Shapes {
-                current_limit: column.current_limit.unwrap_or(law.shapes.current_limit),
-                ..law.shapes
-            })
-            .collect();
-        let mut b = DMatrix::zeros(ctx.m(), columns.len());
-        for i in 0..ctx.n {
-            let t = ctx.times[i];
-            let x = Point {
-                t,
-                current: current.map_or(0.0, |k| ctx.fine.at(k, t)),
-                speed: speed.map_or(0.0, |k| ctx.fine.at(k, t)),
-                voltage: model.input.value_at(t).unwrap_or(model.nominal.voltage),
-                charge: 0.0,
-                heat: 0.0,
-                theta: 0.0,
-            };
-            for (j, column) in columns.iter().enumerate() {
-                b[(c * ctx.n + i, j)] =
-                    dictionary::value(column.function, &x, &shapes[j]) / ctx.sigma[c];
-            }
-        }
-        let b_tilde = ctx.projector.residualize(&b);
-        out.extend(select(ctx, &columns, &b_tilde, &balance, shift, |_| true));
-    }
-    out
 }
 
 /// Forward selection of one balance's columns (see the module's doc), and the fingerprint it
 /// makes.
-fn select(
+pub(super) fn select(
     ctx: &Context,
     columns: &[Column],
     b_tilde: &DMatrix<f64>,
@@ -489,9 +370,10 @@ fn select(
             .filter(|&j| offered(columns[j].function))
             .collect();
         // The moves: each open column, and each harmonic's sin and cos together (of the
-        // angle, and of the angle times the current): a ripple's phase is the record's.
+        // angle, the angle times the current, the speed times the angle in what is read of
+        // ω): a ripple's phase is the record's.
         let mut moves: Vec<Vec<usize>> = open.iter().map(|&j| vec![j]).collect();
-        for [sin, cos] in RIPPLES {
+        for [sin, cos] in RIPPLES.into_iter().chain([dictionary::READING_RIPPLE]) {
             for &j in open.iter().filter(|&&j| columns[j].function == sin) {
                 let k = columns[j].harmonic;
                 let pair = open

@@ -56,6 +56,18 @@ impl FinePrediction {
         self.read(&self.channels[c], t)
     }
 
+    /// The integral of channel c from t = 0 (the trapezoid rule on the fine grid) at each of
+    /// `times`: the angle θ = ∫ω dt of the predicted speed.
+    pub(super) fn integral_at(&self, c: usize, times: &[f64]) -> Vec<f64> {
+        let y = &self.channels[c];
+        let h = self.times[1] - self.times[0];
+        let mut sum = vec![0.0; y.len()];
+        for k in 1..y.len() {
+            sum[k] = sum[k - 1] + 0.5 * h * (y[k - 1] + y[k]);
+        }
+        times.iter().map(|&t| self.read(&sum, t)).collect()
+    }
+
     /// `y`, a series on the fine grid, at time t (linear between grid points).
     fn read(&self, y: &[f64], t: f64) -> f64 {
         let h = self.times[1] - self.times[0];

@@ -132,6 +132,8 @@ impl PhysicsTerm for Law {
         24 "I*cos(k*theta)" "N·m/A" "Ω" "1" "rad/(s·A)",
         25 "U*sin(2*pi*f*t)" "N·m/V" "1" "S" "rad/(s·V)",
         26 "U*cos(2*pi*f*t)" "N·m/V" "1" "S" "rad/(s·V)",
+        27 "omega*sin(k*theta)" "N·m·s/rad" "V·s/rad" "A·s/rad" "1",
+        28 "omega*cos(k*theta)" "N·m·s/rad" "V·s/rad" "A·s/rad" "1",
     );
     const SETTINGS: &'static [TermSetting] = &[
         TermSetting {
