@@ -60,8 +60,9 @@ pub(super) fn fingerprints(
     shift: f64,
 ) -> Vec<Evidence> {
     let model = fit.posterior.forward(0).model();
-    // The functions offered read no shape but the current limit's; the dictionary's defaults
-    // stand for the others.
+    // The functions offered read no shape but the current limit's and the harmonic; the
+    // dictionary's defaults stand for the others. (`harmonics` is the model's own law's k
+    // alone where that law holds a ripple already: a law has one k.)
     let Some(Term::Law(law)) = Term::named("law") else {
         return Vec::new();
     };
