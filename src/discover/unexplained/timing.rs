@@ -179,3 +179,30 @@ pub fn fit(
         gain: best,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The angle of a speed that rises linearly, ω = a + b·t, is a·t + b·t²/2. The trapezoid
+    /// rule is exact on a line, so on the fine grid the angle is the closed form to rounding,
+    /// and between its points (read linearly) within the chord's b·h²/8.
+    #[test]
+    fn the_angle_is_the_speed_s_integral_from_the_start() {
+        let (a, b) = (120.0, 800.0);
+        let times: Vec<f64> = (0..=5000).map(|k| k as f64 * 1e-4).collect();
+        let fine = FinePrediction {
+            channels: vec![times.iter().map(|t| a + b * t).collect()],
+            times,
+        };
+        let samples = [0.0, 0.00123, 0.25, 0.37777, 0.5];
+        for (t, theta) in samples.iter().zip(fine.integral_at(0, &samples)) {
+            let exact = a * t + b * t * t / 2.0;
+            let chord = b * 1e-4 * 1e-4 / 8.0;
+            assert!(
+                (theta - exact).abs() <= chord + 1e-12,
+                "{t}: {theta} vs {exact}"
+            );
+        }
+    }
+}
