@@ -481,10 +481,8 @@ pub fn discovered(fit: &Candidate, gained: f64) -> Option<Discovered> {
     let k = (0..N_FUNCTIONS)
         .any(|f| reads_harmonic(f) && holds(f))
         .then_some(law.shapes.harmonic);
-    let frequency_hz = PERIODIC
-        .iter()
-        .chain(&SUPPLY_RIPPLE)
-        .any(|&p| holds(p))
+    let frequency_hz = (0..N_FUNCTIONS)
+        .any(|f| dictionary::reads_frequency(f) && holds(f))
         .then_some(law.shapes.frequency);
     let current_limit = holds(CURRENT_LIMIT).then_some(law.shapes.current_limit);
     let mut law = Discovered {

@@ -131,10 +131,20 @@ pub fn ripple_of(f: usize) -> Option<usize> {
     RIPPLES.iter().position(|r| r.contains(&f))
 }
 
-/// Whether function `f` reads the angle's harmonic k: a ripple of the balances or of what is
-/// read of ω.
+/// Every sine-and-cosine pair of the angle: the balances' two ripples and what is read of ω's.
+/// A pair at one harmonic is one move of the state fingerprint (a ripple's phase is the
+/// record's), and a law holding any of them has the harmonic k.
+pub const HARMONIC_PAIRS: [[usize; 2]; 3] = [RIPPLES[0], RIPPLES[1], READING_RIPPLE];
+
+/// Whether function `f` reads the angle's harmonic k ([`HARMONIC_PAIRS`]).
 pub fn reads_harmonic(f: usize) -> bool {
-    ripple_of(f).is_some() || READING_RIPPLE.contains(&f)
+    HARMONIC_PAIRS.concat().contains(&f)
+}
+
+/// Whether function `f` reads the frequency f of time: the periodic functions and the
+/// supply's ripple, which the state fingerprint leaves to the oscillation's frequency search.
+pub fn reads_frequency(f: usize) -> bool {
+    PERIODIC.contains(&f) || SUPPLY_RIPPLE.contains(&f)
 }
 
 /// Whether the state fingerprint offers function `f` in balance `b` (0 torque, 1 voltage): the

@@ -245,7 +245,7 @@ pub(super) fn fingerprints(
     };
     let plain: Vec<usize> = (0..N_FUNCTIONS)
         .filter(|&f| f != STRIBECK && f != CURRENT_LIMIT && ripple_of(f).is_none())
-        .filter(|f| !dictionary::PERIODIC.contains(f) && !dictionary::SUPPLY_RIPPLE.contains(f))
+        .filter(|&f| !dictionary::reads_frequency(f))
         // Only what a balance is offered: the others' columns would be solved for nothing.
         .filter(|&f| (0..ODE_BALANCES).any(|b| dictionary::offered_in(f, b)))
         .collect();
@@ -373,7 +373,7 @@ pub(super) fn select(
         // angle, the angle times the current, the speed times the angle in what is read of
         // ω): a ripple's phase is the record's.
         let mut moves: Vec<Vec<usize>> = open.iter().map(|&j| vec![j]).collect();
-        for [sin, cos] in RIPPLES.into_iter().chain([dictionary::READING_RIPPLE]) {
+        for [sin, cos] in dictionary::HARMONIC_PAIRS {
             for &j in open.iter().filter(|&&j| columns[j].function == sin) {
                 let k = columns[j].harmonic;
                 let pair = open
