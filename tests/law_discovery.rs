@@ -52,6 +52,20 @@ fn holds(f: &DiscoveredFunction, truth: f64) -> bool {
     f.q025 <= truth && truth <= f.q975
 }
 
+/// Asserts that each of `law`'s functions, in order, has a 95% interval holding its truth.
+fn assert_intervals_hold(law: &Discovered, truths: &[f64]) {
+    assert_eq!(law.functions.len(), truths.len(), "{}", law.equation);
+    for (function, &truth) in law.functions.iter().zip(truths) {
+        assert!(
+            holds(function, truth),
+            "{}: {truth} outside [{}, {}]",
+            function.name,
+            function.q025,
+            function.q975
+        );
+    }
+}
+
 fn within(estimate: f64, truth: f64, share: f64) -> bool {
     (estimate / truth - 1.0).abs() <= share
 }
@@ -217,15 +231,7 @@ fn a_supply_ripple_on_a_stepping_input_follows_the_input() {
     let law = discovered_in(&d, "voltage", &["U*sin(2*pi*f*t)", "U*cos(2*pi*f*t)"]);
     let found = law.frequency_hz.expect("the law's frequency is reported");
     assert!(within(found, f, 0.005), "{found} Hz vs {f}");
-    for (function, truth) in law.functions.iter().zip([0.0, eps]) {
-        assert!(
-            holds(function, truth),
-            "{}: {truth} outside [{}, {}]",
-            function.name,
-            function.q025,
-            function.q975
-        );
-    }
+    assert_intervals_hold(&law, &[0.0, eps]);
     assert!(d.unexplained.is_none(), "{:?}", d.unexplained);
 }
 
@@ -247,15 +253,7 @@ fn a_mains_pickup_on_the_current_sensor_is_discovered_in_what_is_read() {
     let law = discovered_in(&d, "measurement:I", &["sin(2*pi*f*t)", "cos(2*pi*f*t)"]);
     let found = law.frequency_hz.expect("the law's frequency is reported");
     assert!(within(found, f, 0.005), "{found} Hz vs {f}");
-    for (function, truth) in law.functions.iter().zip([a * phase.cos(), a * phase.sin()]) {
-        assert!(
-            holds(function, truth),
-            "{}: {truth} outside [{}, {}]",
-            function.name,
-            function.q025,
-            function.q975
-        );
-    }
+    assert_intervals_hold(&law, &[a * phase.cos(), a * phase.sin()]);
     assert!(d.unexplained.is_none(), "{:?}", d.unexplained);
 }
 
@@ -276,19 +274,7 @@ fn a_tachogenerator_s_ripple_is_discovered_in_what_is_read_of_the_speed() {
         &["omega*sin(k*theta)", "omega*cos(k*theta)"],
     );
     assert_eq!(law.k, Some(truth_value(&answer, "k")));
-    for (function, truth) in law
-        .functions
-        .iter()
-        .zip([eps * phase.cos(), eps * phase.sin()])
-    {
-        assert!(
-            holds(function, truth),
-            "{}: {truth} outside [{}, {}]",
-            function.name,
-            function.q025,
-            function.q975
-        );
-    }
+    assert_intervals_hold(&law, &[eps * phase.cos(), eps * phase.sin()]);
     assert!(d.unexplained.is_none(), "{:?}", d.unexplained);
 }
 
@@ -344,15 +330,7 @@ fn a_ripple_growing_with_the_current_is_discovered_in_the_current_times_the_angl
     let law = discovered_in(&d, "torque", &["I*sin(k*theta)", "I*cos(k*theta)"]);
     assert_eq!(law.k, Some(truth_value(&answer, "k")));
     let truths = [-eps * c_g * phase.cos(), -eps * c_g * phase.sin()];
-    for (f, truth) in law.functions.iter().zip(truths) {
-        assert!(
-            holds(f, truth),
-            "{}: {truth} outside [{}, {}]",
-            f.name,
-            f.q025,
-            f.q975
-        );
-    }
+    assert_intervals_hold(&law, &truths);
 }
 
 /// A leak on the supply side of the current sensor (what is read is I + g·U;
