@@ -135,8 +135,8 @@ fn input_varies(problem: &Problem) -> bool {
 /// of the fingerprint's (T the record's span). The fingerprint's search regresses the residual
 /// on a sinusoid of constant amplitude, which a ripple following the input's levels is not: on
 /// supply_ripple-560008 (input −24/8/24 V) it peaked at 73.38 Hz against the truth's 74.76,
-/// where the ripple's law fitted 9.0 nats below the model without it (a debug print of the
-/// fits, not kept); searched, it is taken at 74.80 Hz. Within the cell the score through the
+/// where the ripple's law did not beat the plain one; searched, it is taken at 74.80 Hz
+/// (`motorcal diagnose` on the fixture prints both). Within the cell the score through the
 /// ODE has one peak (the next is a cell away), and the frequency stays one of the band's the
 /// fingerprint's grid paid ln G for.
 fn supply_search(problem: &Problem, named: &NamedTerm) -> Option<f64> {
