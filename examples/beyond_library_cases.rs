@@ -19,7 +19,8 @@
 //! `return_spring`, `load_ripple`; then `leakage_current`, `tacho_nonlinearity`, `backlash`;
 //! a third, `current_clip`, `amplifier_saturation`, `speed_quantization`, and `speed_offset`;
 //! a fourth, `mains_pickup`, `bearing_defect`, `tacho_ripple` (the last two on slow records,
-//! `--volts 2`, where their ripples are sampled).
+//! `--volts 2`, where their ripples are sampled); a fifth, `eddy_brake`, `encoder_latency`,
+//! `crank_inertia`.
 //!
 //! cargo run --release --example beyond_library_cases -- [--out DIR] [--per-effect 3]
 //!     [--seed-base 510000] [--min-nats 20] [--max-nats 300] [--effects a,b,…] [--volts 24]
@@ -134,6 +135,16 @@ enum Effect {
     /// A tachogenerator's commutator ripple: ω read as ω·(1 + ε·sin(k·θ + φ)), k 1–3.
     /// `--effects tacho_ripple`.
     TachoRipple { eps: f64, k: u32, phase: f64 },
+    /// An eddy-current brake as the load: a torque −a·ω/(1 + (ω/ω_c)²), viscous at low speed
+    /// and falling past its critical speed ω_c, a share of the no-load speed (0.2–0.6).
+    /// `--effects eddy_brake`.
+    EddyBrake { a: f64, share: f64 },
+    /// A speed estimate that arrives τ late (a fieldbus, an encoder's filter window): ω read
+    /// as ω(t − τ), the current on time. `--effects encoder_latency`.
+    EncoderLatency { tau: f64 },
+    /// A crank or cam whose inertia changes once per revolution, J·(1 + ε·cos θ): the
+    /// equation of motion J(θ)·dω/dt = τ − ½·J'(θ)·ω². `--effects crank_inertia`.
+    CrankInertia { eps: f64 },
 }
 
 impl Effect {
@@ -223,6 +234,12 @@ impl Effect {
                 k: rng.random_range(1..=3u32),
                 phase: rng.random_range(0.0..2.0 * PI),
             },
+            "eddy_brake" => Effect::EddyBrake {
+                a: 1e-6,
+                share: rng.random_range(0.2..0.6),
+            },
+            "encoder_latency" => Effect::EncoderLatency { tau: 1e-4 },
+            "crank_inertia" => Effect::CrankInertia { eps: 1e-2 },
             other => panic!("unknown effect {other}; known: {:?}", Effect::NAMES),
         }
     }
@@ -256,6 +273,9 @@ impl Effect {
             Effect::SpeedOffset { b } => b,
             Effect::MainsPickup { a, .. } | Effect::BearingDefect { a, .. } => a,
             Effect::TachoRipple { eps, .. } => eps,
+            Effect::EddyBrake { a, .. } => a,
+            Effect::EncoderLatency { tau } => tau,
+            Effect::CrankInertia { eps } => eps,
         }
     }
 
@@ -287,6 +307,9 @@ impl Effect {
             Effect::SpeedOffset { b } => *b = s,
             Effect::MainsPickup { a, .. } | Effect::BearingDefect { a, .. } => *a = s,
             Effect::TachoRipple { eps, .. } => *eps = s,
+            Effect::EddyBrake { a, .. } => *a = s,
+            Effect::EncoderLatency { tau } => *tau = s,
+            Effect::CrankInertia { eps } => *eps = s,
         }
         e
     }
@@ -316,6 +339,9 @@ impl Effect {
             // A pickup of at most 50 A; a ripple of at most half the speed.
             Effect::MainsPickup { .. } => 50.0,
             Effect::TachoRipple { .. } => 0.5,
+            // A latency of at most 20 ms; an inertia that varies by at most half.
+            Effect::EncoderLatency { .. } => 0.02,
+            Effect::CrankInertia { .. } => 0.5,
             _ => 1.0,
         }
     }
@@ -442,6 +468,17 @@ fn rhs(
             torque -= a * (k * x[2] + phase).sin();
             dx[2] = w;
         }
+        Some(&Effect::EddyBrake { a, share }) => {
+            // The no-load speed is U/c_m at the record's level.
+            let omega_c = share * input.level / m.c_m;
+            torque -= a * w / (1.0 + (w / omega_c).powi(2));
+        }
+        Some(&Effect::CrankInertia { eps }) => {
+            // J(θ) = J(1 + ε cos θ), J'(θ) = −εJ sin θ.
+            motor_inertia = m.j * (1.0 + eps * x[2].cos());
+            torque += 0.5 * eps * m.j * x[2].sin() * w * w;
+            dx[2] = w;
+        }
         // The angle, which the tacho's ripple reads.
         Some(Effect::TachoRipple { .. }) => dx[2] = w,
         // These act on what is measured (`measured`, `simulate`), not on the motor.
@@ -451,7 +488,8 @@ fn rhs(
             | Effect::CurrentClip { .. }
             | Effect::SpeedQuantization { .. }
             | Effect::SpeedOffset { .. }
-            | Effect::MainsPickup { .. },
+            | Effect::MainsPickup { .. }
+            | Effect::EncoderLatency { .. },
         )
         | None => {}
     }
@@ -490,6 +528,8 @@ fn simulate(m: &Motor, e: Option<&Effect>, input: &Input, times: &[f64]) -> Vec<
     let mut x = [0.0; 4];
     let mut t = 0.0;
     let mut out = Vec::with_capacity(times.len());
+    // The speed at every substep, for a reading that arrives late (linear between substeps).
+    let mut history: Vec<(f64, f64)> = vec![(0.0, 0.0)];
     for &target in times {
         let h = (target - t) / SUBSTEPS as f64;
         for _ in 0..SUBSTEPS {
@@ -503,8 +543,21 @@ fn simulate(m: &Motor, e: Option<&Effect>, input: &Input, times: &[f64]) -> Vec<
                 x[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
             });
             t += h;
+            history.push((t, x[1]));
         }
         let mut y = measured(e, &x);
+        if let Some(&Effect::EncoderLatency { tau }) = e {
+            let late = t - tau;
+            let j = history.partition_point(|p| p.0 <= late);
+            y[1] = if j == 0 {
+                0.0
+            } else if j == history.len() {
+                history[j - 1].1
+            } else {
+                let (a, b) = (history[j - 1], history[j]);
+                a.1 + (b.1 - a.1) * (late - a.0) / (b.0 - a.0)
+            };
+        }
         if let Some(&Effect::LeakageCurrent { g }) = e {
             y[0] += g * input.at(t, times);
         }
@@ -617,6 +670,13 @@ fn expected(e: &Effect) -> String {
         Effect::BearingDefect { k, .. } => format!(r#"{{"kind": "state", "balance": "torque", "functions": ["sin(k*theta)", "cos(k*theta)"], "k": {k}}}"#),
         // ω·sin(k·θ) is in no dictionary: what is read of ω, in the angle.
         Effect::TachoRipple { k, .. } => format!(r#"{{"kind": "state", "balance": "measurement:omega", "functions": ["omega*sin(k*theta)", "omega*cos(k*theta)"], "k": {k}}}"#),
+        // The brake's torque is a function of ω alone, in the torque balance.
+        Effect::EddyBrake { .. } => r#"{"kind": "state", "balance": "torque", "functions": ["omega", "omega^3"]}"#.into(),
+        // One channel late: to first order (a delay's Padé) a lag of the same time on ω.
+        Effect::EncoderLatency { tau } => format!(r#"{{"kind": "lag", "channel": "omega", "seconds": {tau}}}"#),
+        // ω²·sin θ and dω/dt·cos θ are in no dictionary: a state of the torque balance, in
+        // the angle and the speed.
+        Effect::CrankInertia { .. } => r#"{"kind": "state", "balance": "torque", "functions": ["omega^2*sin(theta)", "domega/dt*cos(theta)"]}"#.into(),
         // The torque lost, ε·sin(kθ + φ)·c_g·I, as the law's two coefficients (c_g the nominal's,
         // which the truth keeps).
         Effect::LoadRipple { eps, k, phase } => format!(
