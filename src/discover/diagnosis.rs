@@ -17,8 +17,9 @@ use crate::study::Problem;
 use super::Progress;
 use super::candidate::{Candidate, Confirmation, answer_params};
 use super::coincide::InputCoincidence;
+use super::discovered::{Discovered, discovered};
 use super::fits::{self, Convergence, FitSummary, Mismatch, SampledFit};
-use super::named::{Discovered, discovered, fit_named_terms};
+use super::named::fit_named_terms;
 use super::screen::collinear_pairs;
 use super::selection::Selection;
 use super::settings::{

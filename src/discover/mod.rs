@@ -53,6 +53,7 @@ mod candidate;
 mod coincide;
 mod confirm;
 mod diagnosis;
+mod discovered;
 mod fits;
 mod named;
 mod screen;
@@ -68,8 +69,9 @@ pub use candidate::{Candidate, Confirmation, answer_params, fit_candidate, fit_c
 pub use coincide::{InputCoincidence, InputStep, input_steps};
 pub use confirm::importance_evidence;
 pub use diagnosis::{Diagnosis, PassedOver, RankEntry, StageFit};
+pub use discovered::{Discovered, DiscoveredFunction, discovered};
 pub use fits::{FitSummary, Mismatch, SampledFit, Whiteness, ljung_box};
-pub use named::{Discovered, DiscoveredFunction, NamedTerm, named_term, named_terms};
+pub use named::{NamedTerm, named_term, named_terms};
 pub use selection::{Selection, forward_selection, rank};
 pub use settings::{
     DEFAULT_K, DiscoverSettings, EVIDENCE_THRESHOLD, FitStage, LAPLACE_ABOVE_SAMPLES,

@@ -14,10 +14,7 @@
 //! (log L̂ − ½·d·ln N), and taken when the better of the two beats the selected model by more
 //! than [`EVIDENCE_THRESHOLD`]: the ranking's rule, for the ranking's reason.
 
-use std::collections::BTreeMap;
-
 use rayon::prelude::*;
-use serde::Serialize;
 
 use crate::error::Error;
 use crate::motor::Term;
@@ -31,9 +28,7 @@ use crate::study::Problem;
 
 use super::candidate::{Candidate, Starts, fit_candidate_started};
 use super::settings::EVIDENCE_THRESHOLD;
-use super::unexplained::{
-    EquationTerm, Fingerprint, equation_with, frequency_search_cost, golden_max, with_shapes,
-};
+use super::unexplained::{Fingerprint, frequency_search_cost, golden_max};
 
 /// The term a fingerprint names, with its settings and the parameter values it starts at.
 #[derive(Clone, Debug, PartialEq)]
@@ -46,6 +41,11 @@ pub struct NamedTerm {
     /// The half-width [Hz] of a search through the ODE for a periodic law's frequency around
     /// the one it starts at; none where the fingerprint's frequency is taken as found.
     pub frequency_search: Option<f64>,
+    /// The half-width of a search through the ODE for the angle's harmonic k around the one
+    /// it starts at, where the order search found it between the grid's (`unexplained::order`):
+    /// its residual's peak places k within a quarter of the angle's Fourier spacing, and a
+    /// quarter is a drift of a quarter period over the record.
+    pub harmonic_search: Option<f64>,
 }
 
 /// The terms `fingerprint` names on `problem`'s base: one, or none; a forced oscillation, whose
@@ -72,9 +72,13 @@ pub fn named_terms(problem: &Problem, fingerprint: &Fingerprint) -> Vec<NamedTer
                 named
             })
             .collect(),
-        Fingerprint::State { .. } => named_term(problem, fingerprint)
-            .into_iter()
-            .chain(ripple_twin(fingerprint).and_then(|twin| named_term(problem, &twin)))
+        Fingerprint::State { .. } => std::iter::once(fingerprint.clone())
+            .chain(ripple_twin(fingerprint))
+            .flat_map(|f| {
+                let whole = phase_twin(&f);
+                std::iter::once(f).chain(whole)
+            })
+            .filter_map(|f| named_term(problem, &f))
             .collect(),
         _ => named_term(problem, fingerprint).into_iter().collect(),
     }
@@ -109,6 +113,47 @@ fn ripple_twin(fingerprint: &Fingerprint) -> Option<Fingerprint> {
         swapped = true;
     }
     swapped.then_some(twin)
+}
+
+/// `fingerprint` with the other half of its ripple's sine-and-cosine pair, started at zero,
+/// where it holds one half at an order the order search found (`unexplained::order`). There
+/// the first-order k is off by up to a quarter of the angle's Fourier spacing, so the phase the
+/// linear regression splits between sine and cosine drifts over the record, and one half can
+/// lead at first order where the refined k needs both: on bearing_defect-620001 (truth 5.36
+/// periods per revolution) `cos(k*theta)` alone was selected at 5.34. The fits decide, the
+/// pair paying ½·ln N more.
+fn phase_twin(fingerprint: &Fingerprint) -> Option<Fingerprint> {
+    let mut twin = fingerprint.clone();
+    let Fingerprint::State {
+        functions,
+        harmonic_width,
+        ..
+    } = &mut twin
+    else {
+        return None;
+    };
+    if *harmonic_width <= 0.0 {
+        return None;
+    }
+    let holds = |f: usize| functions.iter().any(|g| g.name == FUNCTIONS[f]);
+    let [held, missing] =
+        dictionary::HARMONIC_PAIRS
+            .into_iter()
+            .find_map(|[s, c]| match (holds(s), holds(c)) {
+                (true, false) => Some([s, c]),
+                (false, true) => Some([c, s]),
+                _ => None,
+            })?;
+    let at = functions.iter().position(|g| g.name == FUNCTIONS[held])?;
+    functions.insert(
+        at + 1,
+        super::unexplained::LawFunction {
+            name: FUNCTIONS[missing].to_string(),
+            coefficient: 0.0,
+            sd: 0.0,
+        },
+    );
+    Some(twin)
 }
 
 /// The balance of what is read of `channel` (a pickup on its sensor's cable: mains hum on a
@@ -178,12 +223,14 @@ fn forced_law(
         start,
         search_penalty: (frequencies.max(1) as f64).ln(),
         frequency_search: None,
+        harmonic_search: None,
     })
 }
 
 /// The term `fingerprint` names on `problem`'s base, if one does.
 pub fn named_term(problem: &Problem, fingerprint: &Fingerprint) -> Option<NamedTerm> {
     let mut search_penalty = 0.0;
+    let mut harmonic_search = None;
     let (term, start) = match fingerprint {
         Fingerprint::Delay { seconds, .. } => {
             (Term::named("input_delay")?, vec![("tau", *seconds)])
@@ -220,8 +267,16 @@ pub fn named_term(problem: &Problem, fingerprint: &Fingerprint) -> Option<NamedT
                     omega_s,
                     harmonic,
                     current_limit,
+                    harmonic_price,
+                    harmonic_width,
                     ..
-                } => (balance, functions, *omega_s, *harmonic, *current_limit),
+                } => {
+                    // A k the order search found pays its grid, as a searched frequency does,
+                    // and is refined through the ODE.
+                    search_penalty = *harmonic_price;
+                    harmonic_search = (*harmonic_width > 0.0).then_some(*harmonic_width);
+                    (balance, functions, *omega_s, *harmonic, *current_limit)
+                }
                 Fingerprint::Drift {
                     balance, functions, ..
                 } => (balance, functions, None, None, None),
@@ -262,6 +317,7 @@ pub fn named_term(problem: &Problem, fingerprint: &Fingerprint) -> Option<NamedT
         start,
         search_penalty,
         frequency_search: None,
+        harmonic_search,
     })
 }
 
@@ -279,26 +335,36 @@ const FREQUENCY_STEPS: usize = 11;
 
 /// `named` fitted beside `with` (the selected terms, or none), started at `with`'s estimates
 /// and the fingerprint's; a frequency found by a grid search pays the grid's multiplicity, as
-/// in the ranking. A law whose frequency is searched is fitted at each frequency tried, and
-/// at the best.
+/// in the ranking. A law whose frequency or harmonic is searched is fitted at each value
+/// tried, and at the best.
 fn fit_named(problem: &Problem, with: &Candidate, named: &NamedTerm) -> Result<Candidate, Error> {
-    let (Some(width), Term::Law(law)) = (named.frequency_search, &named.term) else {
+    let Term::Law(law) = &named.term else {
         return fit_named_at(problem, with, named);
     };
-    let at = |f: f64| {
+    // The shape searched (the frequency, or the angle's harmonic), its start and half-width.
+    let (start, width, frequency) = match (named.frequency_search, named.harmonic_search) {
+        (Some(w), _) => (law.shapes.frequency, w, true),
+        (None, Some(w)) => (law.shapes.harmonic, w, false),
+        (None, None) => return fit_named_at(problem, with, named),
+    };
+    let at = |x: f64| {
         let mut law = law.clone();
-        law.shapes.frequency = f;
+        if frequency {
+            law.shapes.frequency = x;
+        } else {
+            law.shapes.harmonic = x;
+        }
         NamedTerm {
             term: Term::Law(law),
             frequency_search: None,
+            harmonic_search: None,
             ..named.clone()
         }
     };
-    let f0 = law.shapes.frequency;
-    let f = golden_max(f0 - width, f0 + width, FREQUENCY_STEPS, |f| {
-        fit_named_at(problem, with, &at(f)).map_or(f64::NEG_INFINITY, |c| c.score)
+    let x = golden_max(start - width, start + width, FREQUENCY_STEPS, |x| {
+        fit_named_at(problem, with, &at(x)).map_or(f64::NEG_INFINITY, |c| c.score)
     });
-    fit_named_at(problem, with, &at(f))
+    fit_named_at(problem, with, &at(x))
 }
 
 /// `named` fitted beside `with` at its settings as they are.
@@ -412,121 +478,5 @@ impl NamedTerm {
             (Term::Law(a), Term::Law(b)) => a == b,
             (a, b) => a.name() == b.name(),
         }
-    }
-}
-
-/// One function of a discovered law: its coefficient at the MAP and the 95% interval of the
-/// Laplace approximation there (MAP ± 1.96 sd; the coefficients have real support, so the
-/// approximation's coordinate is the coefficient itself).
-#[derive(Clone, Debug, Serialize)]
-pub struct DiscoveredFunction {
-    pub name: String,
-    pub coefficient: f64,
-    pub q025: f64,
-    pub q975: f64,
-}
-
-/// The law term the diagnosis added, as the JSON's `discovered` reports it.
-#[derive(Clone, Debug, Serialize)]
-pub struct Discovered {
-    pub balance: String,
-    pub functions: Vec<DiscoveredFunction>,
-    /// What adding it gained over the model selected before it (nats, the ranking's score).
-    pub score: f64,
-    /// The Stribeck speed ω_s [rad/s], where the law holds the Stribeck function.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub omega_s: Option<f64>,
-    /// The angle's harmonic k (periods per revolution), where the law holds sin or cos(k·θ).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub k: Option<f64>,
-    /// The current limit I_lim [A], where the law holds `sign(I)*max(|I|-I_lim,0)`.
-    #[serde(rename = "I_lim", skip_serializing_if = "Option::is_none")]
-    pub current_limit: Option<f64>,
-    /// The frequency f [Hz] of a periodic law, where it holds sin or cos(2πft).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub frequency_hz: Option<f64>,
-    /// The law as the report prints it, e.g. `J dω/dt += −0.0001·sign(ω)·|I| [95%: …]`.
-    pub equation: String,
-}
-
-/// The law `fit` holds, in the balance whose functions it lists first, with `gained` its
-/// score over the model before it; `None` when it holds none.
-pub fn discovered(fit: &Candidate, gained: f64) -> Option<Discovered> {
-    let law = fit.problem.model.terms.iter().find_map(|t| match &t.term {
-        Term::Law(law) => Some(law),
-        _ => None,
-    })?;
-    let first = *law.active.first()?;
-    let balance = first / N_FUNCTIONS;
-    let sds = fit.map.laplace_sd();
-    let mut functions = Vec::new();
-    for &k in law.active.iter().filter(|&&k| k / N_FUNCTIONS == balance) {
-        let name = format!("law.{}", dictionary::key(k));
-        let i = fit
-            .posterior
-            .calibrated()
-            .iter()
-            .position(|c| c.name == name)?;
-        let value = *fit.theta.get(&name)?;
-        let half = 1.96 * sds[i];
-        functions.push(DiscoveredFunction {
-            name: FUNCTIONS[k % N_FUNCTIONS].to_string(),
-            coefficient: value,
-            q025: value - half,
-            q975: value + half,
-        });
-    }
-    let holds = |f: usize| functions.iter().any(|g| g.name == FUNCTIONS[f]);
-    let omega_s = holds(STRIBECK).then_some(law.shapes.omega_s);
-    let k = (0..N_FUNCTIONS)
-        .any(|f| reads_harmonic(f) && holds(f))
-        .then_some(law.shapes.harmonic);
-    let frequency_hz = (0..N_FUNCTIONS)
-        .any(|f| dictionary::reads_frequency(f) && holds(f))
-        .then_some(law.shapes.frequency);
-    let current_limit = holds(CURRENT_LIMIT).then_some(law.shapes.current_limit);
-    let mut law = Discovered {
-        equation: String::new(),
-        omega_s,
-        k,
-        current_limit,
-        frequency_hz,
-        balance: BALANCES[balance].to_string(),
-        functions,
-        score: gained,
-    };
-    law.write_equation();
-    Some(law)
-}
-
-impl Discovered {
-    fn write_equation(&mut self) {
-        let terms: Vec<EquationTerm> = self
-            .functions
-            .iter()
-            .map(|f| (f.name.clone(), f.coefficient, Some((f.q025, f.q975))))
-            .collect();
-        self.equation = with_shapes(
-            equation_with(&self.balance, &terms),
-            self.k,
-            self.current_limit,
-            self.frequency_hz,
-        );
-    }
-
-    /// The sampled fit's posterior mean and 95% interval in place of the Laplace ones, where
-    /// the fit holds the coefficient (`mean`, `interval` keyed `law.balance:function`).
-    pub fn use_sampled(
-        &mut self,
-        mean: &BTreeMap<String, f64>,
-        interval: &BTreeMap<String, [f64; 2]>,
-    ) {
-        for f in &mut self.functions {
-            let name = format!("law.{}:{}", self.balance, f.name);
-            if let (Some(&m), Some(&[lo, hi])) = (mean.get(&name), interval.get(&name)) {
-                (f.coefficient, f.q025, f.q975) = (m, lo, hi);
-            }
-        }
-        self.write_equation();
     }
 }

@@ -64,6 +64,13 @@ pub enum Fingerprint {
         /// functions.
         #[serde(rename = "I_lim", skip_serializing_if = "Option::is_none")]
         current_limit: Option<f64>,
+        /// What its k's search cost (`order`: ln G where the order search found it, else 0):
+        /// a law named at that k pays it too.
+        #[serde(skip)]
+        harmonic_price: f64,
+        /// And the half-width of the refinement of that k through the ODE (0: none).
+        #[serde(skip)]
+        harmonic_width: f64,
         score: f64,
     },
     /// The balance drifts with time, the charge drawn or the heat dissipated: a state set of
@@ -240,6 +247,13 @@ pub fn with_shapes(
 ) -> String {
     let mut equation = equation;
     if let Some(k) = harmonic {
+        // A whole k as it is (the grid's); one the order search found to three decimals,
+        // finer than its refinement's error on a record of some ten revolutions.
+        let k = if k.fract() == 0.0 {
+            format!("{k}")
+        } else {
+            format!("{k:.3}")
+        };
         equation = equation.replace("k·θ", &format!("{k}·θ"));
     }
     if let Some(i) = current_limit {

@@ -31,6 +31,7 @@
 
 mod as_given;
 mod fingerprint;
+mod order;
 mod oscillation;
 mod reading;
 mod regression;
@@ -52,7 +53,7 @@ use super::candidate::Candidate;
 use super::coincide::input_steps;
 use super::settings::EVIDENCE_THRESHOLD;
 pub use as_given::AsGiven;
-pub use fingerprint::{EquationTerm, Fingerprint, equation_with, with_shapes};
+pub use fingerprint::{EquationTerm, Fingerprint, LawFunction, equation_with, with_shapes};
 use oscillation::Oscillation;
 pub use oscillation::{frequency_search_cost, lowest_frequency_over};
 pub use regression::golden_max;

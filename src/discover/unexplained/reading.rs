@@ -56,7 +56,7 @@ pub(super) fn fingerprints(
     fit: &Candidate,
     ctx: &Context,
     current_limits: &[f64],
-    harmonics: &[f64],
+    harmonics: &[(f64, f64, f64)],
     shift: f64,
 ) -> Vec<Evidence> {
     let model = fit.posterior.forward(0).model();
@@ -106,6 +106,8 @@ pub(super) fn fingerprints(
                 omega_s: None,
                 harmonic: None,
                 current_limit: None,
+                price: 0.0,
+                width: 0.0,
             })
             .collect();
         if Some(c) == current && fresh(CURRENT_LIMIT) {
@@ -114,15 +116,19 @@ pub(super) fn fingerprints(
                 omega_s: None,
                 harmonic: None,
                 current_limit: Some(i),
+                price: 0.0,
+                width: 0.0,
             }));
         }
         if Some(c) == speed && READING_RIPPLE.iter().all(|&f| fresh(f)) {
-            for &k in harmonics {
+            for &(k, price, width) in harmonics {
                 columns.extend(READING_RIPPLE.map(|function| Column {
                     function,
                     omega_s: None,
                     harmonic: Some(k),
                     current_limit: None,
+                    price,
+                    width,
                 }));
             }
         }
@@ -153,7 +159,14 @@ pub(super) fn fingerprints(
             }
         }
         let b_tilde = ctx.projector.residualize(&b);
-        out.extend(select(ctx, &columns, &b_tilde, &balance, shift, |_| true));
+        out.extend(select(
+            ctx,
+            &columns,
+            &b_tilde,
+            &balance,
+            shift,
+            |_: &Column| true,
+        ));
     }
     out
 }

@@ -32,7 +32,9 @@
 //! angle has a phase, so the pair sin(k·θ), cos(k·θ) is also offered as one move, paying
 //! ½·ln N for each of its two coefficients: taken one at a time, neither half of a ripple whose
 //! phase is between them may clear the bar that the two clear together, and the first step
-//! would go to whatever single function mimics the ripple's start. The periodic functions of
+//! would go to whatever single function mimics the ripple's start. A ripple between the
+//! grid's whole k (a bearing's ball-pass order) is offered at the order the residual peaks at
+//! (`order`), its columns paying that search's ln G once. The periodic functions of
 //! time (frequency f a setting) are left to the oscillation alternative, which searches the
 //! frequency. The current limit I_lim of `sign(I)*max(|I|-I_lim,0)` is a shape too, searched
 //! over shares of the model's largest predicted current (a limit above it leaves no trace).
@@ -88,6 +90,12 @@ pub(super) struct Column {
     pub omega_s: Option<f64>,
     pub harmonic: Option<f64>,
     pub current_limit: Option<f64>,
+    /// What a move taking it pays on top of its ½·ln N and the step's look-elsewhere, for a
+    /// shape found by a search of its own (an order between the grid's, `order`: ln G).
+    pub price: f64,
+    /// For such a shape, the half-width of its refinement through the ODE (`named`): a
+    /// quarter of the angle's Fourier spacing, the search grid's step.
+    pub width: f64,
 }
 
 /// How a block of columns shapes the law it is evaluated on.
@@ -211,16 +219,29 @@ pub(super) fn fingerprints(
         Some(l) if holds(STRIBECK) => vec![l.shapes.omega_s],
         _ => STRIBECK_SHARES.iter().map(|s| s * speed).collect(),
     };
-    let harmonics: Vec<f64> = match &own {
+    // Each harmonic with what a column at it pays for its search: the grid's nothing (their
+    // number is in each step's look-elsewhere), the order search's ln G. The model's own law's
+    // k was paid for where it was found.
+    let harmonics: Vec<(f64, f64, f64)> = match &own {
         Some(l) if (0..N_FUNCTIONS).any(|f| dictionary::reads_harmonic(f) && holds(f)) => {
-            vec![l.shapes.harmonic]
+            vec![(l.shapes.harmonic, 0.0, 0.0)]
         }
         _ => {
             let interval = (ctx.times[ctx.n - 1] - ctx.times[0]) / (ctx.n - 1).max(1) as f64;
-            HARMONICS
+            let mut grid: Vec<(f64, f64, f64)> = HARMONICS
                 .into_iter()
                 .filter(|&k| sampled_ripple(k, speed, interval))
-                .collect()
+                .map(|k| (k, 0.0, 0.0))
+                .collect();
+            // The order between the grid's the residual peaks at, where no grid point holds
+            // it: more than one of the angle's Fourier spacings from every one of them.
+            let k_max = (std::f64::consts::PI / (speed * interval)).min(HARMONICS[6]);
+            if let Some(o) = super::order::search(ctx, k_max)
+                && grid.iter().all(|&(k, _, _)| (o.k - k).abs() > o.cell)
+            {
+                grid.push((o.k, o.price, o.cell / 4.0));
+            }
+            grid
         }
     };
     let current_limits: Vec<f64> = match &own {
@@ -252,40 +273,43 @@ pub(super) fn fingerprints(
     let mut columns: Vec<Column> = Vec::new();
     // Per block, its functions; its columns are balance-major (torque's, then voltage's).
     let mut blocks: Vec<(Vec<usize>, DMatrix<f64>)> = Vec::new();
-    let mut add = |functions: Vec<usize>, shape: Shape| -> Result<(), Error> {
-        let keys: Vec<usize> = (0..ODE_BALANCES)
-            .flat_map(|b| functions.iter().map(move |&f| b * N_FUNCTIONS + f))
-            .collect();
-        let b = law_columns(fit, ctx, &law, shape, &keys)?;
-        for &f in &functions {
-            columns.push(Column {
-                function: f,
-                omega_s: match shape {
-                    Shape::StribeckSpeed(w) => Some(w),
-                    _ => None,
-                },
-                harmonic: match shape {
-                    Shape::Harmonic(k) => Some(k),
-                    _ => None,
-                },
-                current_limit: match shape {
-                    Shape::CurrentLimit(i) => Some(i),
-                    _ => None,
-                },
-            });
-        }
-        blocks.push((functions, b));
-        Ok(())
-    };
-    add(plain, Shape::Own)?;
+    let mut add =
+        |functions: Vec<usize>, shape: Shape, price: f64, width: f64| -> Result<(), Error> {
+            let keys: Vec<usize> = (0..ODE_BALANCES)
+                .flat_map(|b| functions.iter().map(move |&f| b * N_FUNCTIONS + f))
+                .collect();
+            let b = law_columns(fit, ctx, &law, shape, &keys)?;
+            for &f in &functions {
+                columns.push(Column {
+                    function: f,
+                    omega_s: match shape {
+                        Shape::StribeckSpeed(w) => Some(w),
+                        _ => None,
+                    },
+                    harmonic: match shape {
+                        Shape::Harmonic(k) => Some(k),
+                        _ => None,
+                    },
+                    current_limit: match shape {
+                        Shape::CurrentLimit(i) => Some(i),
+                        _ => None,
+                    },
+                    price,
+                    width,
+                });
+            }
+            blocks.push((functions, b));
+            Ok(())
+        };
+    add(plain, Shape::Own, 0.0, 0.0)?;
     for w in stribeck_speeds {
-        add(vec![STRIBECK], Shape::StribeckSpeed(w))?;
+        add(vec![STRIBECK], Shape::StribeckSpeed(w), 0.0, 0.0)?;
     }
-    for &k in &harmonics {
-        add(RIPPLES.concat(), Shape::Harmonic(k))?;
+    for &(k, price, width) in &harmonics {
+        add(RIPPLES.concat(), Shape::Harmonic(k), price, width)?;
     }
     for &i in &current_limits {
-        add(vec![CURRENT_LIMIT], Shape::CurrentLimit(i))?;
+        add(vec![CURRENT_LIMIT], Shape::CurrentLimit(i), 0.0, 0.0)?;
     }
     let mut out = Vec::new();
     for balance in 0..ODE_BALANCES {
@@ -308,7 +332,8 @@ pub(super) fn fingerprints(
                 .filter(|&&k| k / N_FUNCTIONS == balance)
                 .find_map(|&k| ripple_of(k % N_FUNCTIONS))
         });
-        let offered = |f: usize| {
+        let offered = |c: &Column| {
+            let f = c.function;
             dictionary::offered_in(f, balance)
                 && ripple_of(f).is_none_or(|r| own_ripple.is_none_or(|o| o == r))
         };
@@ -322,10 +347,27 @@ pub(super) fn fingerprints(
             _ => false,
         };
         let add_ripple = first.as_ref().is_some_and(|e| !took_angle(e));
+        // And the ripple at the order searched between the grid's, where the selection took
+        // another k: to first order a large ripple at the grid's nearest k (in the current's
+        // share of the torque) led on bearing_defect-620001 (truth 5.36 periods per
+        // revolution, I·cos(6θ) taken); the fits decide, as above.
+        let searched = columns
+            .iter()
+            .find(|c| c.price > 0.0)
+            .and_then(|c| c.harmonic);
+        let took_searched = |e: &Evidence| match &e.fingerprint {
+            Fingerprint::State { harmonic, .. } => *harmonic == searched,
+            _ => false,
+        };
+        let add_searched = searched.is_some() && first.as_ref().is_some_and(|e| !took_searched(e));
         out.extend(first);
         if add_ripple {
-            let angle = |f: usize| ripple_of(f).is_some() && offered(f);
+            let angle = |c: &Column| ripple_of(c.function).is_some() && offered(c);
             out.extend(select(ctx, &columns, &b_tilde, name, shift, angle));
+        }
+        if add_searched {
+            let at = |c: &Column| c.harmonic == searched && offered(c);
+            out.extend(select(ctx, &columns, &b_tilde, name, shift, at));
         }
     }
     out.extend(super::reading::fingerprints(
@@ -346,7 +388,7 @@ pub(super) fn select(
     b_tilde: &DMatrix<f64>,
     balance: &str,
     shift: f64,
-    offered: impl Fn(usize) -> bool,
+    offered: impl Fn(&Column) -> bool,
 ) -> Option<Evidence> {
     let mut chosen: Vec<usize> = Vec::new();
     let (mut current, mut score) = (0.0, 0.0);
@@ -367,7 +409,7 @@ pub(super) fn select(
             .filter(|&j| {
                 ripple.is_none() || ripple_of(columns[j].function).is_none_or(|r| Some(r) == ripple)
             })
-            .filter(|&j| offered(columns[j].function))
+            .filter(|&j| offered(&columns[j]))
             .collect();
         // The moves: each open column, and each harmonic's sin and cos together (of the
         // angle, the angle times the current, the speed times the angle in what is read of
@@ -396,7 +438,10 @@ pub(super) fn select(
                 let mut set = chosen.clone();
                 set.extend(m);
                 let g = gain(&ctx.y, &b_tilde.select_columns(&set));
-                let price = 0.5 * ctx.ln_n * m.len() as f64 + look_elsewhere;
+                // A searched order is paid for once, by the move that first takes it.
+                let searched = m.iter().map(|&j| columns[j].price).fold(0.0, f64::max);
+                let searched = if harmonic.is_none() { searched } else { 0.0 };
+                let price = 0.5 * ctx.ln_n * m.len() as f64 + look_elsewhere + searched;
                 (m, g, g - current - price)
             })
             .max_by(|a, b| a.2.total_cmp(&b.2))?;
@@ -443,6 +488,8 @@ pub(super) fn select(
             omega_s: chosen.iter().find_map(|&j| columns[j].omega_s),
             harmonic: chosen.iter().find_map(|&j| columns[j].harmonic),
             current_limit: chosen.iter().find_map(|&j| columns[j].current_limit),
+            harmonic_price: chosen.iter().map(|&j| columns[j].price).fold(0.0, f64::max),
+            harmonic_width: chosen.iter().map(|&j| columns[j].width).fold(0.0, f64::max),
             score: score - shift,
         }
     };

@@ -1,0 +1,130 @@
+//! The law the diagnosis discovered, as the report states it: its balance, functions, their
+//! coefficients with 95% intervals, and the shapes (ω_s, k, I_lim, f) it holds.
+
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+
+use crate::motor::Term;
+use crate::motor::dictionary::{
+    self, BALANCES, CURRENT_LIMIT, FUNCTIONS, N_FUNCTIONS, STRIBECK, reads_harmonic,
+};
+
+use super::candidate::Candidate;
+use super::unexplained::{EquationTerm, equation_with, with_shapes};
+
+/// One function of a discovered law: its coefficient at the MAP and the 95% interval of the
+/// Laplace approximation there (MAP ± 1.96 sd; the coefficients have real support, so the
+/// approximation's coordinate is the coefficient itself).
+#[derive(Clone, Debug, Serialize)]
+pub struct DiscoveredFunction {
+    pub name: String,
+    pub coefficient: f64,
+    pub q025: f64,
+    pub q975: f64,
+}
+
+/// The law term the diagnosis added, as the JSON's `discovered` reports it.
+#[derive(Clone, Debug, Serialize)]
+pub struct Discovered {
+    pub balance: String,
+    pub functions: Vec<DiscoveredFunction>,
+    /// What adding it gained over the model selected before it (nats, the ranking's score).
+    pub score: f64,
+    /// The Stribeck speed ω_s [rad/s], where the law holds the Stribeck function.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub omega_s: Option<f64>,
+    /// The angle's harmonic k (periods per revolution), where the law holds sin or cos(k·θ).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub k: Option<f64>,
+    /// The current limit I_lim [A], where the law holds `sign(I)*max(|I|-I_lim,0)`.
+    #[serde(rename = "I_lim", skip_serializing_if = "Option::is_none")]
+    pub current_limit: Option<f64>,
+    /// The frequency f [Hz] of a periodic law, where it holds sin or cos(2πft).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub frequency_hz: Option<f64>,
+    /// The law as the report prints it, e.g. `J dω/dt += −0.0001·sign(ω)·|I| [95%: …]`.
+    pub equation: String,
+}
+
+/// The law `fit` holds, in the balance whose functions it lists first, with `gained` its
+/// score over the model before it; `None` when it holds none.
+pub fn discovered(fit: &Candidate, gained: f64) -> Option<Discovered> {
+    let law = fit.problem.model.terms.iter().find_map(|t| match &t.term {
+        Term::Law(law) => Some(law),
+        _ => None,
+    })?;
+    let first = *law.active.first()?;
+    let balance = first / N_FUNCTIONS;
+    let sds = fit.map.laplace_sd();
+    let mut functions = Vec::new();
+    for &k in law.active.iter().filter(|&&k| k / N_FUNCTIONS == balance) {
+        let name = format!("law.{}", dictionary::key(k));
+        let i = fit
+            .posterior
+            .calibrated()
+            .iter()
+            .position(|c| c.name == name)?;
+        let value = *fit.theta.get(&name)?;
+        let half = 1.96 * sds[i];
+        functions.push(DiscoveredFunction {
+            name: FUNCTIONS[k % N_FUNCTIONS].to_string(),
+            coefficient: value,
+            q025: value - half,
+            q975: value + half,
+        });
+    }
+    let holds = |f: usize| functions.iter().any(|g| g.name == FUNCTIONS[f]);
+    let omega_s = holds(STRIBECK).then_some(law.shapes.omega_s);
+    let k = (0..N_FUNCTIONS)
+        .any(|f| reads_harmonic(f) && holds(f))
+        .then_some(law.shapes.harmonic);
+    let frequency_hz = (0..N_FUNCTIONS)
+        .any(|f| dictionary::reads_frequency(f) && holds(f))
+        .then_some(law.shapes.frequency);
+    let current_limit = holds(CURRENT_LIMIT).then_some(law.shapes.current_limit);
+    let mut law = Discovered {
+        equation: String::new(),
+        omega_s,
+        k,
+        current_limit,
+        frequency_hz,
+        balance: BALANCES[balance].to_string(),
+        functions,
+        score: gained,
+    };
+    law.write_equation();
+    Some(law)
+}
+
+impl Discovered {
+    fn write_equation(&mut self) {
+        let terms: Vec<EquationTerm> = self
+            .functions
+            .iter()
+            .map(|f| (f.name.clone(), f.coefficient, Some((f.q025, f.q975))))
+            .collect();
+        self.equation = with_shapes(
+            equation_with(&self.balance, &terms),
+            self.k,
+            self.current_limit,
+            self.frequency_hz,
+        );
+    }
+
+    /// The sampled fit's posterior mean and 95% interval in place of the Laplace ones, where
+    /// the fit holds the coefficient (`mean`, `interval` keyed `law.balance:function`).
+    pub fn use_sampled(
+        &mut self,
+        mean: &BTreeMap<String, f64>,
+        interval: &BTreeMap<String, [f64; 2]>,
+    ) {
+        for f in &mut self.functions {
+            let name = format!("law.{}:{}", self.balance, f.name);
+            if let (Some(&m), Some(&[lo, hi])) = (mean.get(&name), interval.get(&name)) {
+                (f.coefficient, f.q025, f.q975) = (m, lo, hi);
+            }
+        }
+        self.write_equation();
+    }
+}

@@ -1,0 +1,151 @@
+//! The angle's order search: a ripple at a number of periods per revolution between the whole
+//! numbers of the state fingerprint's grid.
+//!
+//! A rolling bearing's defect strikes at a ball-pass order, not a whole number of times per
+//! revolution (3.39 or 2.46 on the generator's `bearing_defect` cases): on the grid's nearest
+//! k its sine drifts off the record's by a whole period every 1/|Δk| revolutions, and the law
+//! fitted there was in the wrong functions, with 7.6 to 12.3 nats left. Engineers find such
+//! orders by order analysis, a spectrum of the signal in the shaft's angle rather than in time;
+//! this is that search, on the residual. Its gain at order k is the residual's regression, per
+//! channel, on sin(k·θ) and cos(k·θ) (θ the predicted speed's integral, as the law's own state
+//! is), without the dynamics between a torque and what is read: a ripple passes through them
+//! at its own order, so the peak is where it is, and the fingerprint's columns (`state`, solved
+//! through the ODE at the order found) give the gain that counts.
+//!
+//! The orders searched run from once per revolution (below it a ripple in the angle is, on a
+//! record of one speed, a slow oscillation in time, the oscillation search's) to the most the
+//! record samples (`state::sampled_ripple`), at four points per 1/R (R the revolutions the
+//! record spans: the angle's Fourier spacing, as the frequency grid has four per 1/T). The
+//! order is a setting found by a search, so a column at it pays ln G of that grid, as a
+//! searched frequency does (`study::frequency_grid`).
+
+use super::Context;
+
+/// Grid points per 1/R, the Fourier spacing in the angle: four, as the frequency grid's.
+const OVERSAMPLING: f64 = 4.0;
+
+/// Revolutions a record must span for an order to be told from a trend: two, as a frequency
+/// needs two periods over the record.
+const MIN_REVOLUTIONS: f64 = 2.0;
+
+/// The order found, and what a column at it pays for the search (ln G).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Order {
+    pub k: f64,
+    pub price: f64,
+    /// The angle's Fourier spacing 1/R: orders closer than this are one.
+    pub cell: f64,
+}
+
+/// The angle θ at the record's samples; none without a speed.
+fn angle(ctx: &Context) -> Option<Vec<f64>> {
+    let speed = ctx.channels.iter().position(|c| c == "omega")?;
+    Some(ctx.fine.integral_at(speed, &ctx.times))
+}
+
+/// The best order in [1, `k_max`] of the residual left, refined between its neighbours; none
+/// where the record spans too few revolutions or samples no order above one.
+pub(super) fn search(ctx: &Context, k_max: f64) -> Option<Order> {
+    let theta = angle(ctx)?;
+    let n = ctx.n;
+    let residuals: Vec<&[f64]> = (0..ctx.channels.len())
+        .map(|c| &ctx.y_perp.as_slice()[c * n..(c + 1) * n])
+        .collect();
+    search_in(&theta, &residuals, k_max)
+}
+
+/// [`search`] on the angle at each sample and each channel's residual.
+fn search_in(theta: &[f64], residuals: &[&[f64]], k_max: f64) -> Option<Order> {
+    let (lo, hi) = theta
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &t| {
+            (a.min(t), b.max(t))
+        });
+    let revolutions = (hi - lo) / (2.0 * std::f64::consts::PI);
+    if !(revolutions >= MIN_REVOLUTIONS) || k_max <= 1.0 {
+        return None;
+    }
+    let step = 1.0 / (OVERSAMPLING * revolutions);
+    let grid: Vec<f64> = (0..)
+        .map(|i| 1.0 + i as f64 * step)
+        .take_while(|&k| k <= k_max)
+        .collect();
+    let gain = |k: f64| -> f64 { residuals.iter().map(|y| order_gain(theta, y, k)).sum() };
+    let best = grid
+        .iter()
+        .map(|&k| (k, gain(k)))
+        .max_by(|a, b| a.1.total_cmp(&b.1))?
+        .0;
+    let k =
+        super::regression::golden_max((best - step).max(1.0), (best + step).min(k_max), 12, gain);
+    Some(Order {
+        k,
+        price: (grid.len() as f64).ln(),
+        cell: 1.0 / revolutions,
+    })
+}
+
+/// The gain of the residual `y` regressed on sin(k·θ) and cos(k·θ): ½·hᵀG⁻¹h of the
+/// least-squares fit of the two columns.
+fn order_gain(theta: &[f64], y: &[f64], k: f64) -> f64 {
+    let (mut h, mut g) = ([0.0; 2], [[0.0; 2]; 2]);
+    for (&t, &v) in theta.iter().zip(y) {
+        let (s, co) = (k * t).sin_cos();
+        h[0] += s * v;
+        h[1] += co * v;
+        g[0][0] += s * s;
+        g[0][1] += s * co;
+        g[1][1] += co * co;
+    }
+    let det = g[0][0] * g[1][1] - g[0][1] * g[0][1];
+    if det <= 1e-12 * (g[0][0] * g[1][1]).max(f64::MIN_POSITIVE) {
+        return 0.0;
+    }
+    0.5 * (g[1][1] * h[0] * h[0] - 2.0 * g[0][1] * h[0] * h[1] + g[0][0] * h[1] * h[1]) / det
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_order_between_whole_numbers_is_found_where_the_residual_has_it() {
+        // A record spinning at a steady 200 rad/s for 0.5 s (about 16 revolutions) whose
+        // residual (unit noise, whitened) holds a ripple at 3.39 periods per revolution: the
+        // grid's 3 and 4 miss it by several of the angle's Fourier spacings (1/R), the search
+        // finds it within a quarter of one.
+        use rand::SeedableRng;
+        use rand_distr::{Distribution, Normal};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let noise = Normal::new(0.0, 1.0).unwrap();
+        let times: Vec<f64> = (1..=501).map(|i| i as f64 * 1e-3).collect();
+        let theta: Vec<f64> = times.iter().map(|t| 200.0 * t).collect();
+        let y: Vec<f64> = theta
+            .iter()
+            .map(|th| 0.5 * (3.39 * th + 0.7).sin() + noise.sample(&mut rng))
+            .collect();
+        let revolutions = (theta[500] - theta[0]) / (2.0 * std::f64::consts::PI);
+        let found = search_in(&theta, &[&y], 12.0).expect("16 revolutions are enough");
+        assert!(
+            (found.k - 3.39).abs() < 0.25 / revolutions,
+            "{} vs 3.39",
+            found.k
+        );
+        // The price is ln of the grid's points: four per 1/R over [1, 12].
+        let points = (11.0 * 4.0 * revolutions).floor() + 1.0;
+        assert!((found.price - points.ln()).abs() < 0.01, "{}", found.price);
+        // Pure noise has its best order somewhere, but no gain near the ripple's.
+        let white: Vec<f64> = (0..501).map(|_| noise.sample(&mut rng)).collect();
+        let ripple = order_gain(&theta, &y, found.k);
+        let chance = order_gain(
+            &theta,
+            &white,
+            search_in(&theta, &[&white], 12.0).unwrap().k,
+        );
+        assert!(ripple > 2.0 * chance, "{ripple} vs {chance}");
+        // Too few revolutions, or nothing sampled above once per revolution: no search.
+        let slow: Vec<f64> = times.iter().map(|t| 10.0 * t).collect();
+        assert_eq!(search_in(&slow, &[&y], 12.0), None);
+        assert_eq!(search_in(&theta, &[&y], 1.0), None);
+    }
+}
