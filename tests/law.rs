@@ -84,7 +84,8 @@ fn the_law_s_parameters_are_the_dictionary_in_each_balance() {
 }
 
 /// Every coefficient's dual-number sensitivity against central finite differences, at a value
-/// of a tenth of its prior sd (an effect the record sees, not one that dominates it), solved
+/// of a hundredth of its prior sd, a hundredth of the balance's scale (an effect the record
+/// sees, not one that dominates it), solved
 /// at a relative tolerance of 1e-12: the integrator controls the error of the states, not of
 /// their sensitivities, and a law that feeds the angle's ripple back into a balance (ω·sin(k·θ)
 /// at the paper's 2400 rad/s: a torque ripple at some 380 Hz) has sensitivities whose own
@@ -97,7 +98,7 @@ fn every_coefficient_s_sensitivity_matches_finite_differences() {
     assert_eq!(decls.len(), dictionary::BALANCES.len() * N_FUNCTIONS);
     for (k, decl) in decls.iter().enumerate() {
         let sd = (decl.prior)(&magnitudes).variance().sqrt();
-        let theta = 0.1 * sd;
+        let theta = 0.01 * sd;
         let name = format!("law.{}", dictionary::key(k));
         let fm = ForwardModel::new(
             model(vec![law(&[(k, theta)])]),
