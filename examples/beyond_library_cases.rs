@@ -20,7 +20,8 @@
 //! a third, `current_clip`, `amplifier_saturation`, `speed_quantization`, and `speed_offset`;
 //! a fourth, `mains_pickup`, `bearing_defect`, `tacho_ripple` (the last two on slow records,
 //! `--volts 2`, where their ripples are sampled); a fifth, `eddy_brake`, `encoder_latency`,
-//! `crank_inertia`.
+//! `crank_inertia`; a sixth, `current_sensor_resonance`, `sensor_heat_drift`, `load_ramp`,
+//! `rotor_rub`.
 //!
 //! cargo run --release --example beyond_library_cases -- [--out DIR] [--per-effect 3]
 //!     [--seed-base 510000] [--min-nats 20] [--max-nats 300] [--effects a,b,…] [--volts 24]
@@ -145,6 +146,19 @@ enum Effect {
     /// A crank or cam whose inertia changes once per revolution, J·(1 + ε·cos θ): the
     /// equation of motion J(θ)·dω/dt = τ − ½·J'(θ)·ω². `--effects crank_inertia`.
     CrankInertia { eps: f64 },
+    /// The current sensor a second-order low-pass of f_n Hz and damping ζ (a Hall sensor's
+    /// or its anti-alias filter's resonance). `--effects current_sensor_resonance`.
+    CurrentSensorResonance { f_n: f64, zeta: f64 },
+    /// A Hall current sensor's offset drifting as the winding heats it: I read as I + β·E,
+    /// dE/dt = R·I². `--effects sensor_heat_drift`.
+    SensorHeatDrift { beta: f64 },
+    /// A conveyor filling as it runs: a load torque growing with time, −a·t.
+    /// `--effects load_ramp`.
+    LoadRamp { a: f64 },
+    /// A rotor rubbing its housing over part of each revolution: a torque
+    /// −a·max(cos(θ + φ) − 0.7, 0)·sign(ω), a periodic pulse in the angle, not a sinusoid.
+    /// `--effects rotor_rub`.
+    RotorRub { a: f64, phase: f64 },
 }
 
 impl Effect {
@@ -240,6 +254,16 @@ impl Effect {
             },
             "encoder_latency" => Effect::EncoderLatency { tau: 1e-4 },
             "crank_inertia" => Effect::CrankInertia { eps: 1e-2 },
+            "current_sensor_resonance" => Effect::CurrentSensorResonance {
+                f_n: 200.0,
+                zeta: rng.random_range(0.15..0.4),
+            },
+            "sensor_heat_drift" => Effect::SensorHeatDrift { beta: 1e-2 },
+            "load_ramp" => Effect::LoadRamp { a: 1e-3 },
+            "rotor_rub" => Effect::RotorRub {
+                a: 1e-3,
+                phase: rng.random_range(0.0..2.0 * PI),
+            },
             other => panic!("unknown effect {other}; known: {:?}", Effect::NAMES),
         }
     }
@@ -276,6 +300,9 @@ impl Effect {
             Effect::EddyBrake { a, .. } => a,
             Effect::EncoderLatency { tau } => tau,
             Effect::CrankInertia { eps } => eps,
+            Effect::CurrentSensorResonance { f_n, .. } => 1.0 / f_n,
+            Effect::SensorHeatDrift { beta } => beta,
+            Effect::LoadRamp { a } | Effect::RotorRub { a, .. } => a,
         }
     }
 
@@ -310,6 +337,9 @@ impl Effect {
             Effect::EddyBrake { a, .. } => *a = s,
             Effect::EncoderLatency { tau } => *tau = s,
             Effect::CrankInertia { eps } => *eps = s,
+            Effect::CurrentSensorResonance { f_n, .. } => *f_n = 1.0 / s,
+            Effect::SensorHeatDrift { beta } => *beta = s,
+            Effect::LoadRamp { a } | Effect::RotorRub { a, .. } => *a = s,
         }
         e
     }
@@ -318,7 +348,9 @@ impl Effect {
     /// different case; a supply may sag by at most half).
     fn max_size(&self) -> f64 {
         match self {
-            Effect::ResonantSensor { .. } | Effect::CompliantCoupling { .. } => 1.0 / 60.0,
+            Effect::ResonantSensor { .. }
+            | Effect::CompliantCoupling { .. }
+            | Effect::CurrentSensorResonance { .. } => 1.0 / 60.0,
             Effect::InputDelay { .. } | Effect::SensorLag { .. } => 0.02,
             Effect::SaggingSupply { .. } => 0.5 / 60.0,
             // A limit of 10 A; a ripple of half the supply.
@@ -479,6 +511,17 @@ fn rhs(
             torque += 0.5 * eps * m.j * x[2].sin() * w * w;
             dx[2] = w;
         }
+        Some(&Effect::CurrentSensorResonance { f_n, zeta }) => {
+            let wn = 2.0 * PI * f_n;
+            dx[2] = x[3];
+            dx[3] = wn * wn * (i - x[2]) - 2.0 * zeta * wn * x[3];
+        }
+        Some(Effect::SensorHeatDrift { .. }) => dx[2] = m.r * i * i,
+        Some(&Effect::LoadRamp { a }) => torque -= a * t,
+        Some(&Effect::RotorRub { a, phase }) => {
+            torque -= a * ((x[2] + phase).cos() - 0.7).max(0.0) * w.tanh();
+            dx[2] = w;
+        }
         // The angle, which the tacho's ripple reads.
         Some(Effect::TachoRipple { .. }) => dx[2] = w,
         // These act on what is measured (`measured`, `simulate`), not on the motor.
@@ -513,6 +556,8 @@ fn measured(e: Option<&Effect>, x: &[f64; 4]) -> [f64; 2] {
         Some(&Effect::SensorLag { channel: 0, .. }) => [x[2], x[1]],
         Some(&Effect::SensorLag { .. }) => [x[0], x[2]],
         Some(&Effect::TachoNonlinearity { a }) => [x[0], x[1] + a * x[1] * x[1].abs()],
+        Some(Effect::CurrentSensorResonance { .. }) => [x[2], x[1]],
+        Some(&Effect::SensorHeatDrift { beta }) => [x[0] + beta * x[2], x[1]],
         Some(&Effect::CurrentClip { i_sat }) => [x[0].clamp(-i_sat, i_sat), x[1]],
         Some(&Effect::SpeedQuantization { q }) => [x[0], q * (x[1] / q).round()],
         Some(&Effect::SpeedOffset { b }) => [x[0], x[1] + b],
@@ -677,6 +722,12 @@ fn expected(e: &Effect) -> String {
         // ω²·sin θ and dω/dt·cos θ are in no dictionary: a state of the torque balance, in
         // the angle and the speed.
         Effect::CrankInertia { .. } => r#"{"kind": "state", "balance": "torque", "functions": ["omega^2*sin(theta)", "domega/dt*cos(theta)"]}"#.into(),
+        Effect::CurrentSensorResonance { f_n, zeta } => format!(r#"{{"kind": "oscillation", "frequency_hz": {}, "damping_ratio": {zeta}, "channel": "I", "ringing": true}}"#, f_n * (1.0 - zeta * zeta).sqrt()),
+        // heat is not among what is read's functions: the kind, a drift, is what is asked.
+        Effect::SensorHeatDrift { .. } => r#"{"kind": "drift", "variable": "heat", "balance": "measurement:I"}"#.into(),
+        Effect::LoadRamp { .. } => r#"{"kind": "drift", "variable": "time", "balance": "torque"}"#.into(),
+        // A pulse in the angle: its harmonics, the first of which a 24-V record samples.
+        Effect::RotorRub { .. } => r#"{"kind": "state", "balance": "torque", "functions": ["sin(k*theta)", "cos(k*theta)"], "k": 1}"#.into(),
         // The torque lost, ε·sin(kθ + φ)·c_g·I, as the law's two coefficients (c_g the nominal's,
         // which the truth keeps).
         Effect::LoadRipple { eps, k, phase } => format!(
