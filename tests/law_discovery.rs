@@ -143,7 +143,7 @@ fn a_cogging_torque_on_a_slow_record_is_discovered_at_its_slot_count() {
 /// finds k between the grid's and the law is fitted there. The law in sin(k·θ), cos(k·θ) in
 /// the torque balance, k within 0.5% of the truth, both 95% intervals holding the truth's
 /// −a·cos φ and −a·sin φ (with the law's prior at a tenth of the stall torque, 0.02 N·m on this
-/// 2-V record, they missed it, the amplitude 14% small), nothing left.
+/// 2-V record, the cosine's interval missed it), nothing left.
 #[test]
 fn a_bearing_s_defect_between_whole_orders_is_discovered_at_its_order() {
     let (problem, answer) = fixture("bearing_defect-620003");

@@ -45,9 +45,11 @@ impl Law {
 /// The share of the balance's scale one sd of a law's coefficient stands for: the whole of it.
 /// A library term's prior (`PRIOR_SHARE`, a tenth) says how far a known effect may stray from
 /// its nominal size; a law stands for what the model lacks, whose size nothing in the model
-/// foretells short of the balance's own scale. At a tenth, the ripples of the slow bearing
-/// records (0.09 and 0.18 N·m against a 2-V stall torque of 0.2) came out 14% and 30% small,
-/// and their 95% intervals missed the truth; at the whole scale both hold it.
+/// foretells short of the balance's own scale. At a tenth (0.02 N·m on a 2-V record of the
+/// paper's motor) the slow bearing ripples of a tenth of a newton-metre came out small:
+/// bearing_defect-620005's law printed 0.0507·sin + −0.111·cos against the truth's 0.116 and
+/// −0.132, its intervals missing both; at the whole scale it prints 0.140 and −0.133, and they
+/// hold them.
 const LAW_PRIOR_SHARE: f64 = 10.0 * PRIOR_SHARE;
 
 /// One sd: the balance's scale (stall torque, supply voltage; the current and the speed scales
