@@ -10,7 +10,7 @@ use crate::motor::dictionary::{
 };
 
 use super::super::candidate::Candidate;
-use super::state::{Column, select};
+use super::state::{Column, Harmonic, select};
 use super::{Context, Evidence};
 
 /// The functions a measured channel is offered in (`measurement:I`, `measurement:omega`): a
@@ -56,7 +56,7 @@ pub(super) fn fingerprints(
     fit: &Candidate,
     ctx: &Context,
     current_limits: &[f64],
-    harmonics: &[(f64, f64, f64)],
+    harmonics: &[Harmonic],
     shift: f64,
 ) -> Vec<Evidence> {
     let model = fit.posterior.forward(0).model();
@@ -121,14 +121,14 @@ pub(super) fn fingerprints(
             }));
         }
         if Some(c) == speed && READING_RIPPLE.iter().all(|&f| fresh(f)) {
-            for &(k, price, width) in harmonics {
+            for h in harmonics {
                 columns.extend(READING_RIPPLE.map(|function| Column {
                     function,
                     omega_s: None,
-                    harmonic: Some(k),
+                    harmonic: Some(h.k),
                     current_limit: None,
-                    price,
-                    width,
+                    price: h.price,
+                    width: h.width,
                 }));
             }
         }

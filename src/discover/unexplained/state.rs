@@ -98,6 +98,26 @@ pub(super) struct Column {
     pub width: f64,
 }
 
+/// A harmonic k of the angle offered, with what a column at it pays for its search (the
+/// grid's nothing: their number is in each step's look-elsewhere; the order search's ln G)
+/// and the half-width of its refinement through the ODE (0: none).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Harmonic {
+    pub k: f64,
+    pub price: f64,
+    pub width: f64,
+}
+
+impl Harmonic {
+    fn on_grid(k: f64) -> Self {
+        Self {
+            k,
+            price: 0.0,
+            width: 0.0,
+        }
+    }
+}
+
 /// How a block of columns shapes the law it is evaluated on.
 #[derive(Clone, Copy)]
 enum Shape {
@@ -219,27 +239,31 @@ pub(super) fn fingerprints(
         Some(l) if holds(STRIBECK) => vec![l.shapes.omega_s],
         _ => STRIBECK_SHARES.iter().map(|s| s * speed).collect(),
     };
-    // Each harmonic with what a column at it pays for its search: the grid's nothing (their
-    // number is in each step's look-elsewhere), the order search's ln G. The model's own law's
-    // k was paid for where it was found.
-    let harmonics: Vec<(f64, f64, f64)> = match &own {
+    // The model's own law's k was paid for where it was found.
+    let harmonics: Vec<Harmonic> = match &own {
         Some(l) if (0..N_FUNCTIONS).any(|f| dictionary::reads_harmonic(f) && holds(f)) => {
-            vec![(l.shapes.harmonic, 0.0, 0.0)]
+            vec![Harmonic::on_grid(l.shapes.harmonic)]
         }
         _ => {
             let interval = (ctx.times[ctx.n - 1] - ctx.times[0]) / (ctx.n - 1).max(1) as f64;
-            let mut grid: Vec<(f64, f64, f64)> = HARMONICS
+            let mut grid: Vec<Harmonic> = HARMONICS
                 .into_iter()
                 .filter(|&k| sampled_ripple(k, speed, interval))
-                .map(|k| (k, 0.0, 0.0))
+                .map(Harmonic::on_grid)
                 .collect();
             // The order between the grid's the residual peaks at, where no grid point holds
-            // it: more than one of the angle's Fourier spacings from every one of them.
-            let k_max = (std::f64::consts::PI / (speed * interval)).min(HARMONICS[6]);
+            // it: more than one of the angle's Fourier spacings from every one of them. Up to
+            // what the record samples and the grid's top (above it the inertia averages).
+            let top = HARMONICS[HARMONICS.len() - 1];
+            let k_max = (std::f64::consts::PI / (speed * interval)).min(top);
             if let Some(o) = super::order::search(ctx, k_max)
-                && grid.iter().all(|&(k, _, _)| (o.k - k).abs() > o.cell)
+                && grid.iter().all(|h| (o.k - h.k).abs() > o.cell)
             {
-                grid.push((o.k, o.price, o.cell / 4.0));
+                grid.push(Harmonic {
+                    k: o.k,
+                    price: o.price,
+                    width: o.cell / 4.0,
+                });
             }
             grid
         }
@@ -305,8 +329,8 @@ pub(super) fn fingerprints(
     for w in stribeck_speeds {
         add(vec![STRIBECK], Shape::StribeckSpeed(w), 0.0, 0.0)?;
     }
-    for &(k, price, width) in &harmonics {
-        add(RIPPLES.concat(), Shape::Harmonic(k), price, width)?;
+    for h in &harmonics {
+        add(RIPPLES.concat(), Shape::Harmonic(h.k), h.price, h.width)?;
     }
     for &i in &current_limits {
         add(vec![CURRENT_LIMIT], Shape::CurrentLimit(i), 0.0, 0.0)?;
