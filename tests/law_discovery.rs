@@ -162,6 +162,27 @@ fn a_bearing_s_defect_between_whole_orders_is_discovered_at_its_order() {
     assert!(d.unexplained.is_none(), "{:?}", d.unexplained);
 }
 
+/// The same at 5.36 periods per revolution on a constant input (bearing_defect-620001), where
+/// to first order the current's ripple at the grid's k = 6 led (I·cos(6θ)) and the searched
+/// order's selection took its cosine alone: the law is fitted on the searched order's columns
+/// too, with both halves of its pair, and the fits decide. The law in sin(k·θ), cos(k·θ) at k
+/// within 0.5% of the truth, both 95% intervals holding it, nothing left.
+#[test]
+fn a_bearing_s_defect_is_discovered_at_its_order_where_a_whole_k_led_at_first_order() {
+    let (problem, answer) = fixture("bearing_defect-620001");
+    let (k, a, phase) = (
+        truth_value(&answer, "k"),
+        truth_value(&answer, "a"),
+        truth_value(&answer, "phase"),
+    );
+    let d = diagnose(&problem);
+    let law = discovered_in(&d, "torque", &["sin(k*theta)", "cos(k*theta)"]);
+    let found = law.k.expect("the law reports its k");
+    assert!(within(found, k, 0.005), "{found} vs {k}");
+    assert_intervals_hold(&law, &[-a * phase.cos(), -a * phase.sin()]);
+    assert!(d.unexplained.is_none(), "{:?}", d.unexplained);
+}
+
 /// The law sin θ, cos θ at k = 1 in the torque balance, its amplitude within 30% of the
 /// truth's a, and nothing left unexplained.
 fn assert_the_ripple_is_discovered(case: &str) {
