@@ -121,8 +121,8 @@ fn ripple_twin(fingerprint: &Fingerprint) -> Option<Fingerprint> {
 /// linear regression splits between sine and cosine drifts over the record, and one half can
 /// lead at first order where the refined k needs both: on bearing_defect-620001 (truth 5.356
 /// periods per revolution) `cos(k*theta)` alone was selected at 5.34. The fits decide, the
-/// pair paying ½·ln N more. (Without it the verdict after the cosine's law adds the sine, and
-/// k stays where the cosine alone refined it: 5.341 there, against 5.348 with the pair.)
+/// pair paying ½·ln N more. (Without it that record's law still ends with both halves, at k
+/// 5.341 against 5.348 with the pair: a small gain in k, for the fits it costs.)
 fn phase_twin(fingerprint: &Fingerprint) -> Option<Fingerprint> {
     let mut twin = fingerprint.clone();
     let Fingerprint::State {
