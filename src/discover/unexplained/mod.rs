@@ -112,6 +112,13 @@ impl Context {
         self.n * self.channels.len()
     }
 
+    /// The angle θ at the record's samples, the predicted speed's integral from t = 0 (as the
+    /// law's own state is); none without a speed channel.
+    pub fn angle(&self) -> Option<Vec<f64>> {
+        let speed = self.channels.iter().position(|c| c == "omega")?;
+        Some(self.fine.integral_at(speed, &self.times))
+    }
+
     fn of(problem: &Problem, fit: &Candidate, record: usize) -> Result<Self, Error> {
         let mut posterior = fit.posterior.clone();
         let x = &fit.map.x;

@@ -19,7 +19,10 @@
 //! order is a setting found by a search, so a column at it pays ln G of that grid, as a
 //! searched frequency does (`study::frequency_grid`).
 
+use nalgebra::{DMatrix, DVector};
+
 use super::Context;
+use super::regression::{gain_from_normal_equations, golden_max};
 
 /// Grid points per 1/R, the Fourier spacing in the angle: four, as the frequency grid's.
 const OVERSAMPLING: f64 = 4.0;
@@ -37,16 +40,10 @@ pub(super) struct Order {
     pub cell: f64,
 }
 
-/// The angle θ at the record's samples; none without a speed.
-fn angle(ctx: &Context) -> Option<Vec<f64>> {
-    let speed = ctx.channels.iter().position(|c| c == "omega")?;
-    Some(ctx.fine.integral_at(speed, &ctx.times))
-}
-
 /// The best order in [1, `k_max`] of the residual left, refined between its neighbours; none
 /// where the record spans too few revolutions or samples no order above one.
 pub(super) fn search(ctx: &Context, k_max: f64) -> Option<Order> {
-    let theta = angle(ctx)?;
+    let theta = ctx.angle()?;
     let n = ctx.n;
     let residuals: Vec<&[f64]> = (0..ctx.channels.len())
         .map(|c| &ctx.y_perp.as_slice()[c * n..(c + 1) * n])
@@ -76,8 +73,7 @@ fn search_in(theta: &[f64], residuals: &[&[f64]], k_max: f64) -> Option<Order> {
         .map(|&k| (k, gain(k)))
         .max_by(|a, b| a.1.total_cmp(&b.1))?
         .0;
-    let k =
-        super::regression::golden_max((best - step).max(1.0), (best + step).min(k_max), 12, gain);
+    let k = golden_max((best - step).max(1.0), (best + step).min(k_max), 12, gain);
     Some(Order {
         k,
         price: (grid.len() as f64).ln(),
@@ -85,23 +81,21 @@ fn search_in(theta: &[f64], residuals: &[&[f64]], k_max: f64) -> Option<Order> {
     })
 }
 
-/// The gain of the residual `y` regressed on sin(k·θ) and cos(k·θ): ½·hᵀG⁻¹h of the
-/// least-squares fit of the two columns.
+/// The gain of the residual `y` regressed on sin(k·θ) and cos(k·θ), from the two columns'
+/// normal equations, accumulated without forming the columns.
 fn order_gain(theta: &[f64], y: &[f64], k: f64) -> f64 {
-    let (mut h, mut g) = ([0.0; 2], [[0.0; 2]; 2]);
+    let mut h = DVector::zeros(2);
+    let mut g = DMatrix::zeros(2, 2);
     for (&t, &v) in theta.iter().zip(y) {
-        let (s, co) = (k * t).sin_cos();
+        let (s, c) = (k * t).sin_cos();
         h[0] += s * v;
-        h[1] += co * v;
-        g[0][0] += s * s;
-        g[0][1] += s * co;
-        g[1][1] += co * co;
+        h[1] += c * v;
+        g[(0, 0)] += s * s;
+        g[(0, 1)] += s * c;
+        g[(1, 1)] += c * c;
     }
-    let det = g[0][0] * g[1][1] - g[0][1] * g[0][1];
-    if det <= 1e-12 * (g[0][0] * g[1][1]).max(f64::MIN_POSITIVE) {
-        return 0.0;
-    }
-    0.5 * (g[1][1] * h[0] * h[0] - 2.0 * g[0][1] * h[0] * h[1] + g[0][0] * h[1] * h[1]) / det
+    g[(1, 0)] = g[(0, 1)];
+    gain_from_normal_equations(&h, g)
 }
 
 #[cfg(test)]

@@ -10,7 +10,7 @@ use crate::motor::dictionary::{
 };
 
 use super::super::candidate::Candidate;
-use super::state::{Column, Harmonic, select};
+use super::state::{Column, Harmonic, Shape, select};
 use super::{Context, Evidence};
 
 /// The functions a measured channel is offered in (`measurement:I`, `measurement:omega`): a
@@ -80,6 +80,8 @@ pub(super) fn fingerprints(
         })
         .unwrap_or_default();
     let input_varies = !model.input.breakpoints().is_empty();
+    // The angle, once for both channels (ω's ripple reads it).
+    let theta = ctx.angle().unwrap_or_else(|| vec![0.0; ctx.n]);
     let mut out = Vec::new();
     for (c, channel) in ctx.channels.iter().enumerate() {
         if Some(c) != current && Some(c) != speed {
@@ -101,46 +103,28 @@ pub(super) fn fingerprints(
             .collect();
         let mut columns: Vec<Column> = functions
             .iter()
-            .map(|&function| Column {
-                function,
-                omega_s: None,
-                harmonic: None,
-                current_limit: None,
-                price: 0.0,
-                width: 0.0,
-            })
+            .map(|&f| Column::new(f, Shape::Own))
             .collect();
         if Some(c) == current && fresh(CURRENT_LIMIT) {
-            columns.extend(current_limits.iter().map(|&i| Column {
-                function: CURRENT_LIMIT,
-                omega_s: None,
-                harmonic: None,
-                current_limit: Some(i),
-                price: 0.0,
-                width: 0.0,
-            }));
+            columns.extend(
+                current_limits
+                    .iter()
+                    .map(|&i| Column::new(CURRENT_LIMIT, Shape::CurrentLimit(i))),
+            );
         }
         if Some(c) == speed && READING_RIPPLE.iter().all(|&f| fresh(f)) {
-            for h in harmonics {
-                columns.extend(READING_RIPPLE.map(|function| Column {
-                    function,
-                    omega_s: None,
-                    harmonic: Some(h.k),
-                    current_limit: None,
-                    price: h.price,
-                    width: h.width,
-                }));
+            for &h in harmonics {
+                columns.extend(READING_RIPPLE.map(|f| Column::new(f, Shape::Harmonic(h))));
             }
         }
         let shapes: Vec<Shapes> = columns
             .iter()
             .map(|column| Shapes {
-                current_limit: column.current_limit.unwrap_or(law.shapes.current_limit),
-                harmonic: column.harmonic.unwrap_or(law.shapes.harmonic),
+                current_limit: column.current_limit().unwrap_or(law.shapes.current_limit),
+                harmonic: column.harmonic().unwrap_or(law.shapes.harmonic),
                 ..law.shapes
             })
             .collect();
-        let theta = speed.map_or_else(|| vec![0.0; ctx.n], |k| ctx.fine.integral_at(k, &ctx.times));
         let mut b = DMatrix::zeros(ctx.m(), columns.len());
         for i in 0..ctx.n {
             let t = ctx.times[i];

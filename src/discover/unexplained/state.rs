@@ -87,15 +87,51 @@ fn sampled_ripple(k: f64, speed: f64, interval: f64) -> bool {
 /// Stribeck speed or the angle's harmonic.
 pub(super) struct Column {
     pub function: usize,
-    pub omega_s: Option<f64>,
-    pub harmonic: Option<f64>,
-    pub current_limit: Option<f64>,
+    pub shape: Shape,
+}
+
+impl Column {
+    pub fn new(function: usize, shape: Shape) -> Self {
+        Self { function, shape }
+    }
+
+    pub fn omega_s(&self) -> Option<f64> {
+        match self.shape {
+            Shape::StribeckSpeed(w) => Some(w),
+            _ => None,
+        }
+    }
+
+    pub fn harmonic(&self) -> Option<f64> {
+        match self.shape {
+            Shape::Harmonic(h) => Some(h.k),
+            _ => None,
+        }
+    }
+
+    pub fn current_limit(&self) -> Option<f64> {
+        match self.shape {
+            Shape::CurrentLimit(i) => Some(i),
+            _ => None,
+        }
+    }
+
     /// What a move taking it pays on top of its ½·ln N and the step's look-elsewhere, for a
     /// shape found by a search of its own (an order between the grid's, `order`: ln G).
-    pub price: f64,
-    /// For such a shape, the half-width of its refinement through the ODE (`named`): a
-    /// quarter of the angle's Fourier spacing, the search grid's step.
-    pub width: f64,
+    pub fn price(&self) -> f64 {
+        match self.shape {
+            Shape::Harmonic(h) => h.price,
+            _ => 0.0,
+        }
+    }
+
+    /// For such a shape, the half-width of its refinement through the ODE (`named`).
+    pub fn width(&self) -> f64 {
+        match self.shape {
+            Shape::Harmonic(h) => h.width,
+            _ => 0.0,
+        }
+    }
 }
 
 /// A harmonic k of the angle offered, with what a column at it pays for its search (the
@@ -118,13 +154,13 @@ impl Harmonic {
     }
 }
 
-/// How a block of columns shapes the law it is evaluated on.
+/// How a column (a block of them) shapes the law it is evaluated on.
 #[derive(Clone, Copy)]
-enum Shape {
+pub(super) enum Shape {
     /// The model's law's shapes (or the dictionary's defaults).
     Own,
     StribeckSpeed(f64),
-    Harmonic(f64),
+    Harmonic(Harmonic),
     CurrentLimit(f64),
 }
 
@@ -164,7 +200,7 @@ fn law_columns(
     match shape {
         Shape::Own => {}
         Shape::StribeckSpeed(w) => shapes.omega_s = w,
-        Shape::Harmonic(k) => shapes.harmonic = k,
+        Shape::Harmonic(h) => shapes.harmonic = h.k,
         Shape::CurrentLimit(i) => shapes.current_limit = i,
     }
     let mut shaped = law.clone().with_active(active);
@@ -297,43 +333,24 @@ pub(super) fn fingerprints(
     let mut columns: Vec<Column> = Vec::new();
     // Per block, its functions; its columns are balance-major (torque's, then voltage's).
     let mut blocks: Vec<(Vec<usize>, DMatrix<f64>)> = Vec::new();
-    let mut add =
-        |functions: Vec<usize>, shape: Shape, price: f64, width: f64| -> Result<(), Error> {
-            let keys: Vec<usize> = (0..ODE_BALANCES)
-                .flat_map(|b| functions.iter().map(move |&f| b * N_FUNCTIONS + f))
-                .collect();
-            let b = law_columns(fit, ctx, &law, shape, &keys)?;
-            for &f in &functions {
-                columns.push(Column {
-                    function: f,
-                    omega_s: match shape {
-                        Shape::StribeckSpeed(w) => Some(w),
-                        _ => None,
-                    },
-                    harmonic: match shape {
-                        Shape::Harmonic(k) => Some(k),
-                        _ => None,
-                    },
-                    current_limit: match shape {
-                        Shape::CurrentLimit(i) => Some(i),
-                        _ => None,
-                    },
-                    price,
-                    width,
-                });
-            }
-            blocks.push((functions, b));
-            Ok(())
-        };
-    add(plain, Shape::Own, 0.0, 0.0)?;
+    let mut add = |functions: Vec<usize>, shape: Shape| -> Result<(), Error> {
+        let keys: Vec<usize> = (0..ODE_BALANCES)
+            .flat_map(|b| functions.iter().map(move |&f| b * N_FUNCTIONS + f))
+            .collect();
+        let b = law_columns(fit, ctx, &law, shape, &keys)?;
+        columns.extend(functions.iter().map(|&f| Column::new(f, shape)));
+        blocks.push((functions, b));
+        Ok(())
+    };
+    add(plain, Shape::Own)?;
     for w in stribeck_speeds {
-        add(vec![STRIBECK], Shape::StribeckSpeed(w), 0.0, 0.0)?;
+        add(vec![STRIBECK], Shape::StribeckSpeed(w))?;
     }
-    for h in &harmonics {
-        add(RIPPLES.concat(), Shape::Harmonic(h.k), h.price, h.width)?;
+    for &h in &harmonics {
+        add(RIPPLES.concat(), Shape::Harmonic(h))?;
     }
     for &i in &current_limits {
-        add(vec![CURRENT_LIMIT], Shape::CurrentLimit(i), 0.0, 0.0)?;
+        add(vec![CURRENT_LIMIT], Shape::CurrentLimit(i))?;
     }
     let mut out = Vec::new();
     for balance in 0..ODE_BALANCES {
@@ -377,8 +394,8 @@ pub(super) fn fingerprints(
         // revolution, I·cos(6θ) taken); the fits decide, as above.
         let searched = columns
             .iter()
-            .find(|c| c.price > 0.0)
-            .and_then(|c| c.harmonic);
+            .find(|c| c.price() > 0.0)
+            .and_then(|c| c.harmonic());
         let took_searched = |e: &Evidence| match &e.fingerprint {
             Fingerprint::State { harmonic, .. } => *harmonic == searched,
             _ => false,
@@ -390,7 +407,7 @@ pub(super) fn fingerprints(
             out.extend(select(ctx, &columns, &b_tilde, name, shift, angle));
         }
         if add_searched {
-            let at = |c: &Column| c.harmonic == searched && offered(c);
+            let at = |c: &Column| c.harmonic() == searched && offered(c);
             out.extend(select(ctx, &columns, &b_tilde, name, shift, at));
         }
     }
@@ -418,17 +435,17 @@ pub(super) fn select(
     let (mut current, mut score) = (0.0, 0.0);
     while chosen.len() < MAX_FUNCTIONS {
         // One Stribeck speed and one harmonic at most: the law has one ω_s and one k.
-        let stribeck = chosen.iter().find_map(|&j| columns[j].omega_s);
-        let harmonic = chosen.iter().find_map(|&j| columns[j].harmonic);
-        let limit = chosen.iter().find_map(|&j| columns[j].current_limit);
+        let stribeck = chosen.iter().find_map(|&j| columns[j].omega_s());
+        let harmonic = chosen.iter().find_map(|&j| columns[j].harmonic());
+        let limit = chosen.iter().find_map(|&j| columns[j].current_limit());
         // And one of the angle's two ripples (`dictionary::RIPPLES`).
         let ripple = chosen.iter().find_map(|&j| ripple_of(columns[j].function));
         let open: Vec<usize> = (0..columns.len())
             .filter(|j| !chosen.contains(j))
-            .filter(|&j| stribeck.is_none() || columns[j].omega_s.is_none())
-            .filter(|&j| limit.is_none() || columns[j].current_limit.is_none())
+            .filter(|&j| stribeck.is_none() || columns[j].omega_s().is_none())
+            .filter(|&j| limit.is_none() || columns[j].current_limit().is_none())
             .filter(|&j| {
-                harmonic.is_none() || columns[j].harmonic.is_none_or(|k| Some(k) == harmonic)
+                harmonic.is_none() || columns[j].harmonic().is_none_or(|k| Some(k) == harmonic)
             })
             .filter(|&j| {
                 ripple.is_none() || ripple_of(columns[j].function).is_none_or(|r| Some(r) == ripple)
@@ -441,10 +458,10 @@ pub(super) fn select(
         let mut moves: Vec<Vec<usize>> = open.iter().map(|&j| vec![j]).collect();
         for [sin, cos] in dictionary::HARMONIC_PAIRS {
             for &j in open.iter().filter(|&&j| columns[j].function == sin) {
-                let k = columns[j].harmonic;
+                let k = columns[j].harmonic();
                 let pair = open
                     .iter()
-                    .find(|&&c| columns[c].function == cos && columns[c].harmonic == k);
+                    .find(|&&c| columns[c].function == cos && columns[c].harmonic() == k);
                 if let Some(&c) = pair
                     && chosen.len() + 2 <= MAX_FUNCTIONS
                 {
@@ -463,7 +480,7 @@ pub(super) fn select(
                 set.extend(m);
                 let g = gain(&ctx.y, &b_tilde.select_columns(&set));
                 // A searched order is paid for once, by the move that first takes it.
-                let searched = m.iter().map(|&j| columns[j].price).fold(0.0, f64::max);
+                let searched = m.iter().map(|&j| columns[j].price()).fold(0.0, f64::max);
                 let searched = if harmonic.is_none() { searched } else { 0.0 };
                 let price = 0.5 * ctx.ln_n * m.len() as f64 + look_elsewhere + searched;
                 (m, g, g - current - price)
@@ -509,11 +526,17 @@ pub(super) fn select(
         Fingerprint::State {
             balance,
             functions,
-            omega_s: chosen.iter().find_map(|&j| columns[j].omega_s),
-            harmonic: chosen.iter().find_map(|&j| columns[j].harmonic),
-            current_limit: chosen.iter().find_map(|&j| columns[j].current_limit),
-            harmonic_price: chosen.iter().map(|&j| columns[j].price).fold(0.0, f64::max),
-            harmonic_width: chosen.iter().map(|&j| columns[j].width).fold(0.0, f64::max),
+            omega_s: chosen.iter().find_map(|&j| columns[j].omega_s()),
+            harmonic: chosen.iter().find_map(|&j| columns[j].harmonic()),
+            current_limit: chosen.iter().find_map(|&j| columns[j].current_limit()),
+            harmonic_price: chosen
+                .iter()
+                .map(|&j| columns[j].price())
+                .fold(0.0, f64::max),
+            harmonic_width: chosen
+                .iter()
+                .map(|&j| columns[j].width())
+                .fold(0.0, f64::max),
             score: score - shift,
         }
     };
