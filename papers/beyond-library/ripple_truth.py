@@ -9,6 +9,7 @@ truth (a function the law does not hold is held at zero).
 import json, math, os, re, sys
 
 cases, reports = sys.argv[1], sys.argv[2]
+held_both = laws = 0
 print("| case | truth k | law's k | truth sin, cos | law's sin [95%] | law's cos [95%] | both hold |")
 print("|---|---|---|---|---|---|---|")
 for case in sorted(os.listdir(cases)):
@@ -24,6 +25,7 @@ for case in sorted(os.listdir(cases)):
     want = {"sin(k*theta)": -a * math.cos(phase), "cos(k*theta)": -a * math.sin(phase)}
     law = json.load(open(p)).get("discovered")
     if not law or law["balance"] != "torque":
+        laws += 1
         print(f"| {case} | {k:.3f} | — | {want['sin(k*theta)']:.4g}, {want['cos(k*theta)']:.4g} | — | — | no law in the torque balance |")
         continue
     got = {f["name"]: f for f in law["functions"]}
@@ -37,5 +39,8 @@ for case in sorted(os.listdir(cases)):
             cells.append("—")
             held = False
     others = [n for n in got if n not in want]
+    laws += 1
+    held_both += held and not others
     print(f"| {case} | {k:.3f} | {law.get('k', float('nan')):.3f} | {want['sin(k*theta)']:.4g}, {want['cos(k*theta)']:.4g} | "
           f"{cells[0]} | {cells[1]} | {'yes' if held and not others else 'no' + (' (also ' + ', '.join(others) + ')' if others else '')} |")
+print(f"\nboth intervals hold the truth: {held_both} of {laws}")
