@@ -24,7 +24,7 @@ mod psis;
 pub use ess::{ess_bulk, ess_mean, ess_tail, mcse_mean, mcse_sd};
 pub use fft::autocovariance;
 pub use normal::inverse_normal_cdf;
-pub use psis::{KHAT_GOOD, KHAT_UNRELIABLE, Psis, psis, psis_with_reff};
+pub use psis::{KHAT_GOOD, KHAT_UNRELIABLE, Psis, khat_threshold, psis, psis_with_reff};
 
 use serde::Serialize;
 

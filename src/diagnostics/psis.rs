@@ -21,6 +21,18 @@ pub const KHAT_GOOD: f64 = 0.5;
 /// Above this k̂ the importance estimate cannot be trusted.
 pub const KHAT_UNRELIABLE: f64 = 0.7;
 
+/// The k̂ below which a Pareto-smoothed estimate from `draws` weights is reliable, the
+/// sample-size rule of Vehtari et al. (2024, §3.2.4, eq. 13): min(1 − 1/log₁₀ S, 0.7). Below
+/// it the smoothed estimate's error is small with high probability at this S; the line rises
+/// with S (0.5 at 100 draws, 0.67 at 1000) and stops at 0.7, above which the smoothing's bias
+/// dominates whatever S. Fewer than ten draws can be trusted at no k̂.
+pub fn khat_threshold(draws: usize) -> f64 {
+    if draws < 10 {
+        return f64::NEG_INFINITY;
+    }
+    (1.0 - 1.0 / (draws as f64).log10()).min(KHAT_UNRELIABLE)
+}
+
 /// ArviZ's fit grid is 30 + ⌊√n⌋ points; its prior on k is worth 10 observations at k = 0.5.
 const GRID_BASE: usize = 30;
 const PRIOR_B_SCALE: f64 = 3.0;
@@ -213,6 +225,24 @@ mod tests {
                 -0.5 * x * x + 0.5 * z * z + s.ln()
             })
             .collect()
+    }
+
+    /// The published line at the sample sizes loo's NEWS (2.7.0) tabulates for it: 0.5, 0.6,
+    /// 0.67, 0.7 and the cap 0.7 at 100, 320, 1000, 2200 and 10000 draws.
+    #[test]
+    fn the_trusted_khat_rises_with_the_draws_to_seven_tenths() {
+        for (draws, line) in [
+            (100, 0.5),
+            (320, 0.6),
+            (1000, 0.67),
+            (2200, 0.7),
+            (10_000, 0.7),
+        ] {
+            let threshold = khat_threshold(draws);
+            assert!((threshold - line).abs() < 0.005, "{draws}: {threshold}");
+        }
+        assert!(khat_threshold(2000) > KHAT_GOOD && khat_threshold(2000) < KHAT_UNRELIABLE);
+        assert_eq!(khat_threshold(5), f64::NEG_INFINITY);
     }
 
     /// For q = N(0, s²) with s < 1 the weights' tail is Pareto with shape k = 1 − s² (their

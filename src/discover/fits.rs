@@ -9,7 +9,7 @@ use statrs::distribution::{ChiSquared, ContinuousCDF};
 
 use crate::bayes::{CalibrationPosterior, ModelSettings};
 use crate::density::LogDensity;
-use crate::diagnostics::{KHAT_GOOD, autocovariance};
+use crate::diagnostics::{autocovariance, khat_threshold};
 use crate::error::Error;
 use crate::optimize::{MapSettings, find_map};
 use crate::pipeline::{
@@ -84,7 +84,7 @@ pub struct Convergence {
     /// PSIS k̂ of importance sampling from the Laplace approximation (null where it was not
     /// tried: a long record's Laplace draws).
     pub khat: Option<f64>,
-    /// Whether k̂ ≥ 0.5 sent the fit to NUTS.
+    /// Whether k̂ above the line of [`khat_threshold`] sent the fit to NUTS.
     pub fell_back: bool,
 }
 
@@ -128,10 +128,12 @@ pub fn sample(
     Ok(SampledFit { posterior, run })
 }
 
-/// `laplace-is` with `run`'s chains × draws proposals, kept where k̂ ≤ 0.5, the bound below
-/// which Pareto-smoothed importance sampling converges at the Monte Carlo rate (Vehtari et al.,
-/// "Pareto smoothed importance sampling"); above it, laplace-is's own fallback (NUTS on the
-/// same problem, the k̂ kept). The calibration posteriors are close to Gaussian in their
+/// `laplace-is` with `run`'s chains × draws proposals, kept where k̂ is below the line at
+/// which a Pareto-smoothed estimate from that many weights is reliable, min(1 − 1/log₁₀ S, 0.7)
+/// (Vehtari et al. 2024, eq. 13: 0.697 at diagnose's 4 × 500); above it, laplace-is's own
+/// fallback (NUTS on the same problem, the k̂ kept). The line was 0.5 (the older paper's
+/// "finite variance" bound) until a bearing's fit at k̂ 0.55 spent 37 s of a 47-s diagnosis in
+/// a NUTS run with 77 divergences (papers/beyond-library.md, session 4). The calibration posteriors are close to Gaussian in their
 /// unconstrained coordinates, so most fits stay on the importance path: one plain solve per
 /// proposal against a dual-number solve per leapfrog step.
 fn importance_or_sampler(
@@ -142,7 +144,7 @@ fn importance_or_sampler(
     let importance = RunSettings {
         sampler: SamplerKind::LaplaceIs,
         fallback: true,
-        fallback_above: KHAT_GOOD,
+        fallback_above: khat_threshold(run.chains * run.chain.draws),
         // The fit starts at a candidate's MAP, found by the ranking's search.
         map_search: MapSearch::Ranking,
         // The run's warm-up is NUTS's; importance sampling's is its own recentring (BM2 fits
