@@ -316,3 +316,35 @@ fn friction_growing_with_the_current_is_fingerprinted_as_a_law_of_the_state() {
         other => panic!("fingerprint {other:?}"),
     }
 }
+
+/// An encoder's speed read in steps of q = 24.7 rad/s, 2.5 σ (speed_quantization-650053 of
+/// `--effects … --per-effect 2 --seed-base 650000`, 126 nats of noise-free miss): the error a
+/// step adds is white in time, and before the reading's own value was searched the record
+/// printed "nothing missing found". The error is a sawtooth in the value read: the verdict is
+/// unexplained, its fingerprint a law of what is read of ω, periodic in ω at the step, found
+/// within 1%, and the suggestion says it is a reading in steps.
+#[test]
+fn a_speed_read_in_steps_is_not_nothing_missing_and_its_step_is_found() {
+    let (problem, answer) = fixture("speed_quantization-650053");
+    let q = truth_value(&answer, "q");
+    let d = whole_library(&problem);
+    let u = d
+        .unexplained
+        .expect("a step of 2.5 σ is not nothing missing");
+    match &u.fingerprint {
+        Fingerprint::State {
+            balance,
+            functions,
+            step,
+            ..
+        } => {
+            assert_eq!(balance, "measurement:omega");
+            let names: Vec<&str> = functions.iter().map(|f| f.name.as_str()).collect();
+            assert_eq!(names, ["sin(2*pi*omega/q)", "cos(2*pi*omega/q)"]);
+            let found = step.expect("the step is reported");
+            assert!(within(found, q, 0.01), "{found} vs {q}");
+        }
+        other => panic!("expected a reading in steps, found {other:?}"),
+    }
+    assert!(u.suggestion.contains("steps"), "{}", u.suggestion);
+}

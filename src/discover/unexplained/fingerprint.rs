@@ -64,6 +64,10 @@ pub enum Fingerprint {
         /// functions.
         #[serde(rename = "I_lim", skip_serializing_if = "Option::is_none")]
         current_limit: Option<f64>,
+        /// The step q of `sin(2*pi*<channel>/q)`, `cos(2*pi*<channel>/q)` (in the channel's
+        /// unit), where what is read is rounded to steps (`quantized`).
+        #[serde(rename = "q", skip_serializing_if = "Option::is_none")]
+        step: Option<f64>,
         /// What its k's search cost (`order`: ln G where the order search found it, else 0):
         /// a law named at that k pays it too.
         #[serde(skip)]
@@ -124,6 +128,13 @@ impl Fingerprint {
             } => format!("oscillation/{channel}/{ringing}/{sensor}"),
             Fingerprint::Delay { .. } => "delay".into(),
             Fingerprint::Lag { channel, .. } => format!("lag/{channel}"),
+            // A reading in steps is not a smooth function of the state: it does not displace
+            // the state fingerprint of the same reading, nor it the steps.
+            Fingerprint::State {
+                balance,
+                step: Some(_),
+                ..
+            } => format!("state/{balance}/steps"),
             Fingerprint::State { balance, .. } => format!("state/{balance}"),
             Fingerprint::Drift { .. } => "drift".into(),
             Fingerprint::Unknown { .. } => "unknown".into(),
@@ -180,6 +191,17 @@ impl Fingerprint {
                 "{channel} lags the model with a time constant of {:.3} ms: a filter in its \
                  sensor or logger (the term sensor_lag on {channel})",
                 seconds * 1e3
+            ),
+            Fingerprint::State {
+                balance,
+                step: Some(q),
+                ..
+            } => format!(
+                "what is read of {} follows its own value with a period of {q:.4}: the reading \
+                 rounded to steps of that size (an encoder's counts per sample period, an ADC's \
+                 least bit), which no law of the state holds; a finer sensor, or the step in \
+                 the model, would settle it",
+                balance.trim_start_matches("measurement:")
             ),
             Fingerprint::State {
                 balance, functions, ..

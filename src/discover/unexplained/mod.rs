@@ -33,6 +33,7 @@ mod as_given;
 mod fingerprint;
 mod order;
 mod oscillation;
+mod quantized;
 mod reading;
 mod regression;
 mod resonance;
@@ -360,6 +361,7 @@ fn scores(ctx: &Context, shift: f64) -> Scores {
                 explained: o.scored.explained.fitted.as_slice().to_vec(),
             });
         }
+        fingerprints.extend(quantized::evidence(ctx, c, shift));
         // A lag: y_measured ≈ ŷ − τ·dŷ/dt on this channel alone (τ > 0), then fitted exactly.
         let d = DMatrix::from_column_slice(n, 1, &ctx.derivative(c));
         let s = ctx.score(&ctx.in_channel(c, &d), 0.0);

@@ -83,7 +83,7 @@ fn search_in(theta: &[f64], residuals: &[&[f64]], k_max: f64) -> Option<Order> {
 
 /// The gain of the residual `y` regressed on sin(k·θ) and cos(k·θ), from the two columns'
 /// normal equations, accumulated without forming the columns.
-fn order_gain(theta: &[f64], y: &[f64], k: f64) -> f64 {
+pub(super) fn order_gain(theta: &[f64], y: &[f64], k: f64) -> f64 {
     let mut h = DVector::zeros(2);
     let mut g = DMatrix::zeros(2, 2);
     for (&t, &v) in theta.iter().zip(y) {

@@ -529,6 +529,7 @@ pub(super) fn select(
             omega_s: chosen.iter().find_map(|&j| columns[j].omega_s()),
             harmonic: chosen.iter().find_map(|&j| columns[j].harmonic()),
             current_limit: chosen.iter().find_map(|&j| columns[j].current_limit()),
+            step: None,
             harmonic_price: chosen
                 .iter()
                 .map(|&j| columns[j].price())
