@@ -124,7 +124,6 @@ impl MapSettings {
             rounds: 1,
             cost_with_gradient: true,
             stop_at_rounding: true,
-            ..Self::default()
         }
     }
 }
