@@ -15,8 +15,10 @@
 //! The steps searched: at most a sixteenth of the span the record sweeps (a sensor of four
 //! bits over the range recorded; a coarser one is a shape of the value the state fingerprint's
 //! smooth functions hold), and at least the step whose fundamental, fitted perfectly, would
-//! pay its two coefficients: n·(q/π)²/(4σ²) = ln N, q = 2πσ·√(ln N/n). The grid is cut at
-//! [`MAX_POINTS`] from the coarse end, so that a long record's search stays cheap.
+//! pay its two coefficients: n·(q/π)²/(4σ²) = ln N, q = 2πσ·√(ln N/n). The grid is cut from
+//! the coarse end at [`MAX_POINTS`], and at [`MAX_EVALUATIONS`] / n points on a record longer
+//! than 512 samples, so that a long record's search costs what a short one's does (it then
+//! searches the coarser steps only).
 //!
 //! No law term holds a sawtooth, so the fingerprint names none: the verdict says what is read
 //! follows its own value in steps, and the step found.
@@ -37,6 +39,9 @@ const MIN_LEVELS: f64 = 16.0;
 /// The most points the grid of 1/q takes.
 const MAX_POINTS: usize = 4096;
 
+/// The most (grid point, sample) pairs the search evaluates: [`MAX_POINTS`] on 512 samples.
+const MAX_EVALUATIONS: usize = MAX_POINTS * 512;
+
 /// The evidence that what is read of channel `c` is rounded to a step, on the model `ctx` is
 /// the residual of; none where the channel's span leaves no step to search.
 pub(super) fn evidence(ctx: &Context, c: usize, shift: f64) -> Option<Evidence> {
@@ -51,7 +56,8 @@ pub(super) fn evidence(ctx: &Context, c: usize, shift: f64) -> Option<Evidence> 
     let span = hi - lo;
     let q_min = 2.0 * std::f64::consts::PI * ctx.sigma[c] * (ctx.ln_n / n as f64).sqrt();
     let (nu_min, spacing) = (MIN_LEVELS / span, 1.0 / (OVERSAMPLING * span));
-    let nu_max = (1.0 / q_min).min(nu_min + MAX_POINTS as f64 * spacing);
+    let points = MAX_POINTS.min(MAX_EVALUATIONS / n);
+    let nu_max = (1.0 / q_min).min(nu_min + points as f64 * spacing);
     if !(span > 0.0 && nu_max > nu_min) {
         return None;
     }
