@@ -133,9 +133,10 @@ pub fn sample(
 /// (Vehtari et al. 2024, eq. 13: 0.697 at diagnose's 4 × 500); above it, laplace-is's own
 /// fallback (NUTS on the same problem, the k̂ kept). The line was 0.5 (the older paper's
 /// "finite variance" bound) until a bearing's fit at k̂ 0.55 spent 37 s of a 47-s diagnosis in
-/// a NUTS run with 77 divergences (papers/beyond-library.md, session 4). The calibration posteriors are close to Gaussian in their
-/// unconstrained coordinates, so most fits stay on the importance path: one plain solve per
-/// proposal against a dual-number solve per leapfrog step.
+/// a NUTS run with 77 divergences (papers/beyond-library.md, session 4). The calibration
+/// posteriors are close to Gaussian in their unconstrained coordinates, so most fits stay on
+/// the importance path: one plain solve per proposal against a dual-number solve per leapfrog
+/// step.
 fn importance_or_sampler(
     posterior: &mut CalibrationPosterior,
     run: &RunSettings,

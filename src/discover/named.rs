@@ -364,9 +364,7 @@ fn fit_named(problem: &Problem, with: &Candidate, named: &NamedTerm) -> Result<C
     };
     // The values tried lie within a quarter of the record's Fourier spacing of the start, where
     // the coefficients hardly move: each fit continues from the fit at the start, not from the
-    // fingerprint's regression. On a law whose fit crawls (a Stribeck hump narrower than a
-    // sample's change of speed, which makes the ODE stiff: load_ripple-650047's model as
-    // given) twelve cold fits took 67 s.
+    // fingerprint's regression (what bounds a fit that crawls is `MapSettings::ranking`'s cap).
     let first = fit_named_at(problem, with, &at(start), None).ok();
     let x = golden_max(start - width, start + width, FREQUENCY_STEPS, |x| {
         fit_named_at(problem, with, &at(x), first.as_ref()).map_or(f64::NEG_INFINITY, |c| c.score)
