@@ -11,7 +11,9 @@ noise-free miss). A case is outside the library where that term leaves at least 
 (default 10); the table also prints the count at 3, 5, 20 and 30, so that the figure does not
 rest on one cut.
 """
-import json, os, re, sys
+import json, os, sys
+
+from library_left import library_left
 
 args = sys.argv[1:]
 cut = 10.0
@@ -21,11 +23,7 @@ if args and args[0] == "--outside":
 rows = []
 for triple in args:
     cases, reports, residual = triple.split(":")
-    left = {}
-    for line in open(residual):
-        c = [x.strip() for x in line.split("|")]
-        if len(c) > 5 and re.match(r"[a-z_]+-\d+$", c[1]):
-            left[c[1]] = float(c[4])
+    left = library_left(residual)
     for case in sorted(os.listdir(cases)):
         report = os.path.join(reports, case, "report.json")
         if not os.path.exists(report):

@@ -9,17 +9,15 @@ together, is listed for reading, since that table scores single terms of the thi
     rule_breaks.py CASES:REPORTS:LIBRARY_RESIDUAL ...
 
 REPORTS holds REPORTS/CASE/report.json (`motorcal diagnose --rank-only --json`)."""
-import json, os, re, sys
+import json, os, sys
+
+from library_left import library_left
 
 nothing, standing = [], []
 total = 0
 for triple in sys.argv[1:]:
     cases, reports, residual = triple.split(":")
-    left = {}
-    for line in open(residual):
-        c = [x.strip() for x in line.split("|")]
-        if len(c) > 5 and re.match(r"[a-z_]+-\d+$", c[1]):
-            left[c[1]] = float(c[4])
+    left = library_left(residual)
     for case in sorted(os.listdir(cases)):
         path = os.path.join(reports, case, "report.json")
         if not os.path.exists(path):
