@@ -104,9 +104,9 @@ impl Default for MapSettings {
 /// polish, Newton steps on the Fisher metric, is what converges; L-BFGS only approaches it
 /// cheaply. On a law that makes the ODE stiff (a Stribeck hump narrower than a sample's change
 /// of speed) the log density is rough at the integrator's tolerance and L-BFGS never reaches
-/// its gradient tolerance: six of load_ripple-650047's fits of such a law ran to the 2000
-/// iterations of the precise search and three more stopped at 900–1500, 73 s of a rank-only
-/// diagnosis.
+/// its gradient tolerance: on load_ripple-650047 most fits of such a law ran to the precise
+/// search's 2000 iterations (a temporary count), and the whole command took 73.3 s, 20.7 s with
+/// this cap (papers/beyond-library.md, session 5, `whole_commands.py`).
 const RANKING_ITERATIONS: u64 = 100;
 
 impl MapSettings {

@@ -29,10 +29,10 @@ pub(super) fn nuts_instead<P: Fittable>(
 ) -> Result<RunOutput, Error> {
     // Where k̂ > 0.7 (or none could be fitted) the Laplace covariance is no metric to trust
     // either: NUTS re-estimates it in Stan's windows, with their warm-up. Between a stricter
-    // line and 0.7 (the independence chain falls back above 0.5, diagnose's fits above min(1 − 1/log₁₀ S, 0.7)) the
-    // approximation was refused for weighing draws, whose error converges slowly there, not as
-    // a shape: NUTS keeps it as its metric, tunes only the step size, and its own R-hat and ESS
-    // judge the result.
+    // line and 0.7 (the independence chain falls back above 0.5, diagnose's fits above
+    // min(1 − 1/log₁₀ S, 0.7)) the approximation was refused for weighing draws, whose error
+    // converges slowly there, not as a shape: NUTS keeps it as its metric, tunes only the step
+    // size, and its own R-hat and ESS judge the result.
     let metric_adaptation = if khat <= KHAT_UNRELIABLE {
         MetricAdaptation::Laplace
     } else {

@@ -22,7 +22,7 @@
 use nalgebra::{DMatrix, DVector};
 
 use super::Context;
-use super::regression::{gain_from_normal_equations, golden_max};
+use super::regression::{gain_from_normal_equations, grid_peak};
 
 /// Grid points per 1/R, the Fourier spacing in the angle: four, as the frequency grid's.
 const OVERSAMPLING: f64 = 4.0;
@@ -63,20 +63,11 @@ fn search_in(theta: &[f64], residuals: &[&[f64]], k_max: f64) -> Option<Order> {
         return None;
     }
     let step = 1.0 / (OVERSAMPLING * revolutions);
-    let grid: Vec<f64> = (0..)
-        .map(|i| 1.0 + i as f64 * step)
-        .take_while(|&k| k <= k_max)
-        .collect();
     let gain = |k: f64| -> f64 { residuals.iter().map(|y| order_gain(theta, y, k)).sum() };
-    let best = grid
-        .iter()
-        .map(|&k| (k, gain(k)))
-        .max_by(|a, b| a.1.total_cmp(&b.1))?
-        .0;
-    let k = golden_max((best - step).max(1.0), (best + step).min(k_max), 12, gain);
+    let (k, points) = grid_peak(1.0, k_max, step, gain)?;
     Some(Order {
         k,
-        price: (grid.len() as f64).ln(),
+        price: (points as f64).ln(),
         cell: 1.0 / revolutions,
     })
 }

@@ -27,7 +27,7 @@ use nalgebra::DMatrix;
 
 use super::fingerprint::LawFunction;
 use super::order::order_gain;
-use super::regression::{coefficient_sds, golden_max};
+use super::regression::{coefficient_sds, grid_peak};
 use super::{Context, Evidence, Fingerprint};
 
 /// Grid points per 1/span, the value's Fourier spacing: four, as the order and frequency grids.
@@ -65,29 +65,16 @@ pub(super) fn evidence(ctx: &Context, c: usize, shift: f64) -> Option<Evidence> 
         .iter()
         .map(|v| 2.0 * std::f64::consts::PI * v)
         .collect();
-    let grid: Vec<f64> = (0..)
-        .map(|i| nu_min + i as f64 * spacing)
-        .take_while(|&nu| nu <= nu_max)
-        .collect();
-    let gain = |nu: f64| order_gain(&phase, residual, nu);
-    let best = grid
-        .iter()
-        .map(|&nu| (nu, gain(nu)))
-        .max_by(|a, b| a.1.total_cmp(&b.1))?
-        .0;
-    let nu = golden_max(
-        (best - spacing).max(nu_min),
-        (best + spacing).min(nu_max),
-        12,
-        gain,
-    );
+    let (nu, points) = grid_peak(nu_min, nu_max, spacing, |nu| {
+        order_gain(&phase, residual, nu)
+    })?;
     // The pair in the channel's rows, whitened as the residual is: coefficients in its unit.
     let columns = DMatrix::from_fn(n, 2, |i, j| {
         let (s, co) = (nu * phase[i]).sin_cos();
         (if j == 0 { s } else { co }) / ctx.sigma[c]
     });
     let b = ctx.in_channel(c, &columns);
-    let scored = ctx.score(&b, (grid.len() as f64).ln());
+    let scored = ctx.score(&b, (points as f64).ln());
     let sds = coefficient_sds(&ctx.projector.residualize(&b));
     let channel = &ctx.channels[c];
     let functions = ["sin", "cos"]

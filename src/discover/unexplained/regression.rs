@@ -134,6 +134,24 @@ pub fn golden_max(lo: f64, hi: f64, steps: usize, mut g: impl FnMut(f64) -> f64)
     (a + b) / 2.0
 }
 
+/// The best of `gain` on the grid lo, lo + step, … ≤ hi, refined by golden section between
+/// its neighbours (within [lo, hi]), and the grid's size G (a setting found this way pays
+/// ln G): the order search's and the reading's step search's one pattern. None on an empty
+/// grid.
+pub fn grid_peak(lo: f64, hi: f64, step: f64, gain: impl Fn(f64) -> f64) -> Option<(f64, usize)> {
+    let grid: Vec<f64> = (0..)
+        .map(|i| lo + i as f64 * step)
+        .take_while(|&x| x <= hi)
+        .collect();
+    let best = grid
+        .iter()
+        .map(|&x| (x, gain(x)))
+        .max_by(|a, b| a.1.total_cmp(&b.1))?
+        .0;
+    let x = golden_max((best - step).max(lo), (best + step).min(hi), 12, gain);
+    Some((x, grid.len()))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
