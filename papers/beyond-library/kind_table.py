@@ -11,9 +11,9 @@ noise-free miss). A case is outside the library where that term leaves at least 
 (default 10); the table also prints the count at 3, 5, 20 and 30, so that the figure does not
 rest on one cut.
 """
-import json, os, sys
+import sys
 
-from library_left import library_left
+from case_sets import cases_with_reports
 
 args = sys.argv[1:]
 cut = 10.0
@@ -21,17 +21,10 @@ if args and args[0] == "--outside":
     cut = float(args[1]); args = args[2:]
 
 rows = []
-for triple in args:
-    cases, reports, residual = triple.split(":")
-    left = library_left(residual)
-    for case in sorted(os.listdir(cases)):
-        report = os.path.join(reports, case, "report.json")
-        if not os.path.exists(report):
-            continue
-        truth = json.load(open(os.path.join(cases, case, "answer.json")))["fingerprint"]["kind"]
-        given = json.load(open(report)).get("unexplained_as_given")
-        kind = given["fingerprint"]["kind"] if given else None
-        rows.append((case, truth, kind, left.get(case, float("nan"))))
+for case, answer, report, nats in cases_with_reports(args):
+    given = report.get("unexplained_as_given")
+    kind = given["fingerprint"]["kind"] if given else None
+    rows.append((case, answer["fingerprint"]["kind"], kind, nats))
 
 print("| case | truth's kind | the model as given's | left by the library's best term (nats) |")
 print("|---|---|---|---|")

@@ -9,29 +9,21 @@ together, is listed for reading, since that table scores single terms of the thi
     rule_breaks.py CASES:REPORTS:LIBRARY_RESIDUAL ...
 
 REPORTS holds REPORTS/CASE/report.json (`motorcal diagnose --rank-only --json`)."""
-import json, os, sys
+import sys
 
-from library_left import library_left
+from case_sets import cases_with_reports
 
 nothing, standing = [], []
 total = 0
-for triple in sys.argv[1:]:
-    cases, reports, residual = triple.split(":")
-    left = library_left(residual)
-    for case in sorted(os.listdir(cases)):
-        path = os.path.join(reports, case, "report.json")
-        if not os.path.exists(path):
-            continue
-        total += 1
-        miss = json.load(open(os.path.join(cases, case, "answer.json")))["miss_nats"]
-        r = json.load(open(path))
-        if r["unexplained"]:
-            continue
-        if not r["selected_set"] and miss >= 30:
-            nothing.append(f"{case} ({miss:.1f} nats)")
-        lib = left.get(case, float("nan"))
-        if r["selected_set"] and "law" not in r["selected_set"] and lib >= 10:
-            standing.append(f"{case}: {' + '.join(r['selected_set'])} ({lib:.1f} nats left by the best single term)")
+for case, answer, r, lib in cases_with_reports(sys.argv[1:]):
+    total += 1
+    miss = answer["miss_nats"]
+    if r["unexplained"]:
+        continue
+    if not r["selected_set"] and miss >= 30:
+        nothing.append(f"{case} ({miss:.1f} nats)")
+    if r["selected_set"] and "law" not in r["selected_set"] and lib >= 10:
+        standing.append(f"{case}: {' + '.join(r['selected_set'])} ({lib:.1f} nats left by the best single term)")
 print(f"{total} cases")
 print(f"\"nothing missing found\" on a miss of 30 nats or more: {len(nothing)}")
 for x in nothing:
