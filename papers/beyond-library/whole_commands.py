@@ -31,6 +31,7 @@ times = sorted((r["runtime_s"], n) for n, r in runs.items())
 print(f"{len(times)} whole commands: runtime max {times[-1][0]:.1f} s ({times[-1][1]}), "
       f"median {statistics.median(t for t, _ in times):.1f} s; over 30 s: "
       f"{sum(t > 30 for t, _ in times)}")
+print("slowest five: " + ", ".join(f"{name} {t:.1f} s" for t, name in reversed(times[-5:])))
 print("\n| case | law's balance | σ_I after / own noise | σ_ω after / own noise | within 10% |")
 print("|---|---|---|---|---|")
 n = ok = 0
