@@ -20,6 +20,7 @@ use super::coincide::InputCoincidence;
 use super::discovered::{Discovered, discovered};
 use super::fits::{self, Convergence, FitSummary, Mismatch, SampledFit};
 use super::named::fit_named_terms;
+use super::prune::prune_law;
 use super::screen::collinear_pairs;
 use super::selection::Selection;
 use super::settings::{
@@ -270,6 +271,12 @@ pub fn assemble(
             _ => None,
         };
         if let Some(fit) = extended {
+            found = discovered(&fit, fit.score - before);
+            selected_fit = fit;
+            left = unexplained(problem, &selected_fit, &none, &as_given)?;
+        }
+        // The law's functions were chosen at first order; through the ODE each must pay.
+        if let Some(fit) = prune_law(problem, &selected_fit)? {
             found = discovered(&fit, fit.score - before);
             selected_fit = fit;
             left = unexplained(problem, &selected_fit, &none, &as_given)?;

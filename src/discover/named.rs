@@ -418,7 +418,7 @@ fn fit_named_at(
 }
 
 /// The law `fit`'s model holds, if one.
-fn law_of(fit: &Candidate) -> Option<&Law> {
+pub(super) fn law_of(fit: &Candidate) -> Option<&Law> {
     fit.problem.model.terms.iter().find_map(|t| match &t.term {
         Term::Law(law) => Some(law),
         _ => None,

@@ -136,6 +136,17 @@ pub fn ripple_of(f: usize) -> Option<usize> {
 /// record's), and a law holding any of them has the harmonic k.
 pub const HARMONIC_PAIRS: [[usize; 2]; 3] = [RIPPLES[0], RIPPLES[1], READING_RIPPLE];
 
+/// Every sine-and-cosine pair, of the angle and of time: a sinusoid's amplitude and phase, one
+/// quantity in two coefficients. Its phase is where the record's θ or t happens to start, so a
+/// law keeps or drops the pair together (`discover::named::prune_law`).
+pub const PHASE_PAIRS: [[usize; 2]; 5] = [
+    RIPPLES[0],
+    RIPPLES[1],
+    READING_RIPPLE,
+    PERIODIC,
+    SUPPLY_RIPPLE,
+];
+
 /// Whether function `f` reads the angle's harmonic k ([`HARMONIC_PAIRS`]).
 pub fn reads_harmonic(f: usize) -> bool {
     HARMONIC_PAIRS.concat().contains(&f)
