@@ -8,7 +8,7 @@ use motorcal::io::ModelFile;
 use motorcal::motor::{MotorModel, MotorParameters, VoltageInput};
 use motorcal::pipeline::{MetricAdaptation, RunSettings, SamplerKind, default_warmup, run_sampler};
 use motorcal::sampler::ChainSettings;
-use motorcal::sampler::targets::Banana;
+use motorcal::sampler::targets::{Banana, StudentT};
 use motorcal::study::cases::{DURATION, NOISE_SD, SAMPLES};
 use motorcal::study::{Problem, recording_from};
 use motorcal::synthetic::{generate, sample_times};
@@ -158,6 +158,47 @@ fn a_friction_term_at_its_bound_is_flagged_by_khat_and_falls_back_to_nuts() {
     assert!(run.max_rhat <= 1.01, "R-hat {}", run.max_rhat);
     assert!(run.min_ess_bulk >= 400.0, "bulk ESS {}", run.min_ess_bulk);
     assert_eq!(run.divergences, 0);
+}
+
+/// A second, defensive proposal (`defensive_proposal`, what a diagnosis's fits ask for) on a
+/// Student-t target with 6 degrees of freedom in 3 dimensions. The first proposal, a t with 30
+/// at the Laplace scale, has lighter tails than the target: its weights grow as |x|^24 there and
+/// their tail index is about 1 − 6/30 = 0.8, so k̂ falls back. The second, a t with 5 at 1.5
+/// times the scale, has heavier tails than the target, bounded weights, and is kept by its own
+/// k̂ — and it draws the target: the means within 0.1 of 0, the variance pooled over the three
+/// coordinates within 15% of 6/4 (the t's fourth moment is finite at 6, so the sample variance
+/// of ~2000 effective draws has a relative sd of about 5%).
+#[test]
+fn a_wider_proposal_tried_before_nuts_covers_tails_heavier_than_the_first_s_and_is_kept() {
+    let mut target = StudentT { df: 6.0, dim: 3 };
+    let first = run_sampler(&mut target, &is_settings(false, 1000), "t6").unwrap();
+    let first_khat = first.khat.unwrap();
+    let defensive = RunSettings {
+        defensive_proposal: true,
+        ..is_settings(true, 1000)
+    };
+    let run = run_sampler(&mut target, &defensive, "t6").unwrap();
+    let khat = run.khat.unwrap();
+    eprintln!(
+        "first proposal k̂ {first_khat:.3}; the second's {khat:.3}, fell back: {}",
+        run.fell_back
+    );
+    assert!(first_khat > 0.7, "k̂ = {first_khat}");
+    assert!(!run.fell_back && khat <= 0.7, "k̂ = {khat}");
+    assert_eq!(run.sampler, "laplace-is");
+    // The proposals refused are counted in the warm-up: 4 × 1000 densities.
+    assert!(run.warmup.density_evaluations >= 4000);
+    let mut pooled = 0.0;
+    for i in 1..=3 {
+        let s = run.summary(&format!("x.{i}")).unwrap();
+        assert!(s.mean.abs() < 0.1, "x.{i}: mean {}", s.mean);
+        pooled += s.sd * s.sd / 3.0;
+    }
+    let truth = target.variance();
+    assert!(
+        (pooled / truth - 1.0).abs() < 0.15,
+        "variance {pooled} vs {truth}"
+    );
 }
 
 /// The friction target for the independence sampler: its warm-up's proposals come from a

@@ -130,8 +130,9 @@ pub fn sample(
 
 /// `laplace-is` with `run`'s chains × draws proposals, kept where k̂ is below the line at
 /// which a Pareto-smoothed estimate from that many weights is reliable, min(1 − 1/log₁₀ S, 0.7)
-/// (Vehtari et al. 2024, eq. 13: 0.697 at diagnose's 4 × 500); above it, laplace-is's own
-/// fallback (NUTS on the same problem, the k̂ kept). The line was 0.5 (the older paper's
+/// (Vehtari et al. 2024, eq. 13: 0.697 at diagnose's 4 × 500); above it, a second, wider
+/// proposal judged by the same line (`RunSettings::defensive_proposal`), and above that too,
+/// laplace-is's own fallback (NUTS on the same problem, the first k̂ kept). The line was 0.5 (the older paper's
 /// "finite variance" bound) until a bearing's fit at k̂ 0.55 spent 37 s of a 47-s diagnosis in
 /// a NUTS run with 77 divergences (papers/beyond-library.md, session 4). The calibration
 /// posteriors are close to Gaussian in their unconstrained coordinates, so most fits stay on
@@ -146,6 +147,7 @@ fn importance_or_sampler(
         sampler: SamplerKind::LaplaceIs,
         fallback: true,
         fallback_above: khat_threshold(run.chains * run.chain.draws),
+        defensive_proposal: true,
         // The fit starts at a candidate's MAP, found by the ranking's search.
         map_search: MapSearch::Ranking,
         // The run's warm-up is NUTS's; importance sampling's is its own recentring (BM2 fits

@@ -17,6 +17,21 @@ use crate::sampler::proposal::LaplaceProposal;
 /// the Gaussian's, which in 10–50 dimensions decides how much of the sample carries weight.
 pub const IS_SHAPE: (f64, f64) = (30.0, 1.0);
 
+/// The second proposal's degrees of freedom and scale ([`RunSettings::defensive_proposal`]):
+/// tails of a t with 5 degrees of freedom, 1.5 times the Laplace scale. A k̂ above the line
+/// says the posterior reaches where the first proposal puts too little mass — a skewed
+/// marginal, a second mode, a curved ridge — and a wider proposal with polynomial tails covers
+/// those at the price of weights spread thinner, which a fit of a few parameters (BM1) can
+/// pay: on cogging-660005's and bearing_defect-660007's fits after their laws (BM1, a few
+/// parameters) the first proposal fell back, the second is kept, and the NUTS run that took
+/// most of each diagnosis is not needed (papers/beyond-library.md, session 6). The t's heavier
+/// tails are defensive importance sampling (Hesterberg 1995) in its simplest form: a proposal
+/// whose tails dominate the target's.
+pub const DEFENSIVE_SHAPE: (f64, f64) = (5.0, 1.5);
+
+/// What the second proposal's seed differs by, so that its draws are not the first's rescaled.
+const DEFENSIVE_SEED: u64 = 0xdef5_e1f0;
+
 /// Importance sampling of `posterior` from the Student-t at `map`: `chains × draws` proposals,
 /// resampled. Its `min_ess_bulk` is the smaller of the smoothed weights' ESS and the resampled
 /// draws' bulk ESS. With `collapsed-is` the Student-t is the Laplace approximation's marginal in
@@ -37,7 +52,7 @@ pub(super) fn laplace_is<P: Fittable>(
     } else {
         Proposed::Everything
     };
-    let proposal = if proposed == Proposed::Leading {
+    let laplace = if proposed == Proposed::Leading {
         let leading = posterior.conditioned_on().ok_or_else(|| {
             Error::invalid(
                 "collapsed-is needs a posterior whose noise scales (and coefficients) have conditionals given θ",
@@ -47,7 +62,6 @@ pub(super) fn laplace_is<P: Fittable>(
     } else {
         LaplaceProposal::new(&map.x, &map.hessian)
     }
-    .and_then(|p| p.with_shape(IS_SHAPE.0, IS_SHAPE.1))
     .map_err(Error::Numerical)?;
     // The recentring corrects the offset of the scales' marginal from the joint mode under
     // many linear coefficients (BM2). Without them (BM1) the marginals that are off their mode
@@ -59,31 +73,50 @@ pub(super) fn laplace_is<P: Fittable>(
     } else {
         0
     };
-    let work = || {
-        importance_sample_with(
-            &proposal,
-            proposed,
-            settings.chains,
-            recentring,
-            settings.chain.draws,
-            settings.seed,
-            |_| Ok::<_, DensityError>(posterior.clone()),
-        )
+    let attempts: &[((f64, f64), u64)] = if settings.defensive_proposal {
+        &[(IS_SHAPE, 0), (DEFENSIVE_SHAPE, DEFENSIVE_SEED)]
+    } else {
+        &[(IS_SHAPE, 0)]
     };
-    let run = super::in_pool(settings.threads, work)??;
-    let khat = run.khat();
-    let weights_ess = run.weights_ess();
-    let mut output = RunOutput {
-        map: map_cost,
-        khat: Some(khat),
-        ..finish_run(settings.sampler.name(), run.chains, map, started)
-    };
-    output.min_ess_bulk = output.min_ess_bulk.min(weights_ess);
-    if !falls_back(khat, settings, f64::INFINITY) {
-        return Ok(output);
+    let mut spent = PhaseCost::default();
+    let mut first_khat = None;
+    let mut map_cost = map_cost;
+    for &((df, scale), seed) in attempts {
+        let proposal = laplace
+            .clone()
+            .with_shape(df, scale)
+            .map_err(Error::Numerical)?;
+        let work = || {
+            importance_sample_with(
+                &proposal,
+                proposed,
+                settings.chains,
+                recentring,
+                settings.chain.draws,
+                settings.seed ^ seed,
+                |_| Ok::<_, DensityError>(posterior.clone()),
+            )
+        };
+        let run = super::in_pool(settings.threads, work)??;
+        let khat = run.khat();
+        let weights_ess = run.weights_ess();
+        let mut output = RunOutput {
+            map: map_cost,
+            khat: Some(khat),
+            ..finish_run(settings.sampler.name(), run.chains, map, started)
+        };
+        output.min_ess_bulk = output.min_ess_bulk.min(weights_ess);
+        if !falls_back(khat, settings, f64::INFINITY) {
+            // A proposal refused before is counted in the warm-up of the one kept.
+            output.warmup = spent + output.warmup;
+            return Ok(output);
+        }
+        spent = spent + output.warmup + output.sampling;
+        first_khat.get_or_insert(khat);
+        map_cost = output.map;
     }
-    let spent = output.warmup + output.sampling;
-    nuts_instead(posterior, settings, label, khat, output.map, spent, started)
+    let khat = first_khat.unwrap_or(f64::NAN);
+    nuts_instead(posterior, settings, label, khat, map_cost, spent, started)
 }
 
 /// The Laplace approximation's marginal in the first `leading` coordinates: N(x̂_θ, (H⁻¹)_θθ).

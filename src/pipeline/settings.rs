@@ -205,10 +205,14 @@ pub struct RunSettings {
     /// Laplace approximation cannot be trusted.
     pub fallback: bool,
     /// laplace-is, independence: the k̂ above which they fall back (0.7, where PSIS stops being
-    /// reliable, by default; a diagnosis's fits ask for 0.5, below which its estimates converge
-    /// at the Monte Carlo rate; the independence chain never goes above 0.5, where its mean
-    /// stay at a point becomes infinite).
+    /// reliable, by default; a diagnosis's fits ask for min(1 − 1/log₁₀ S, 0.7), the line for
+    /// their S proposals; the independence chain never goes above 0.5, where its mean stay at
+    /// a point becomes infinite).
     pub fallback_above: f64,
+    /// laplace-is: where the first proposal's k̂ falls back, importance sampling is tried once
+    /// more, from a wider Student-t with heavier tails ([`super::importance::DEFENSIVE_SHAPE`]),
+    /// before NUTS; its own k̂ judges it by the same line.
+    pub defensive_proposal: bool,
     /// The MAP search the run starts from.
     #[serde(skip)]
     pub map_search: MapSearch,
@@ -255,6 +259,7 @@ impl Default for RunSettings {
             transitions: None,
             fallback: true,
             fallback_above: crate::diagnostics::KHAT_UNRELIABLE,
+            defensive_proposal: false,
             map_search: MapSearch::Precise,
         }
     }
