@@ -347,4 +347,21 @@ fn a_speed_read_in_steps_is_not_nothing_missing_and_its_step_is_found() {
         other => panic!("expected a reading in steps, found {other:?}"),
     }
     assert!(u.suggestion.contains("steps"), "{}", u.suggestion);
+    // The figure folds ω's residual onto one step of the predicted ω: the rounding error
+    // round(ω/q)·q − ω falls from 0 to −q/2 over the first half of a step and from +q/2 to 0
+    // over the second, so the halves' means are −q/4 and +q/4, ∓0.5 in the residual's σ
+    // (σ² = noise² + q²/12 with q = 2.5 noise σ). Asserted: each half on its side by at least
+    // half of that, which noise of 250 samples a half (sd 0.06) does not reach by chance.
+    let folded = u.figure.folded.as_ref().expect("the reading is folded");
+    assert_eq!(folded.channel, "omega");
+    let half_mean = |first: bool| {
+        let values: Vec<f64> = (folded.phase.iter().zip(&folded.residual))
+            .filter(|&(&p, _)| (p < 0.5) == first)
+            .map(|(_, &r)| r)
+            .collect();
+        values.iter().sum::<f64>() / values.len() as f64
+    };
+    let (first, second) = (half_mean(true), half_mean(false));
+    eprintln!("folded halves: {first:.3}, {second:.3}");
+    assert!(first < -0.25 && second > 0.25, "{first}, {second}");
 }

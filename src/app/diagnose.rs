@@ -256,6 +256,20 @@ fn unexplained_plot(u: &crate::discover::Unexplained, model: &str) -> crate::plo
             curve_label: "a sinusoid through the record".into(),
         });
     }
+    if let Some(folded) = &f.folded {
+        rows.push(crate::plot::UnexplainedRow {
+            x_desc: format!("{}, fraction of a period", folded.variable),
+            y_desc: format!("{} residual [σ]", folded.channel),
+            x: folded.phase.clone(),
+            points: folded.residual.clone(),
+            points_label: format!("residual of {model}, folded"),
+            curve: folded.binned.clone(),
+            curve_label: format!(
+                "its mean over 1/{} of a period",
+                crate::discover::FOLDED_BINS
+            ),
+        });
+    }
     crate::plot::UnexplainedPlot {
         title: format!(
             "left unexplained: {lead} ({:+.1} nats over {model})",

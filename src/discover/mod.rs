@@ -80,7 +80,7 @@ pub use settings::{
 };
 pub use state::{StateFingerprint, records_reverse};
 pub use ties::TIE_EXPERIMENTS;
-pub use unexplained::{Fingerprint, Span, Unexplained, UnexplainedFigure};
+pub use unexplained::{FOLDED_BINS, Fingerprint, Folded, Span, Unexplained, UnexplainedFigure};
 
 use crate::bayes::ModelSettings;
 use crate::error::Error;

@@ -30,6 +30,7 @@
 //! are listed as alternatives.
 
 mod as_given;
+mod figure;
 mod fingerprint;
 mod order;
 mod oscillation;
@@ -54,6 +55,7 @@ use super::candidate::Candidate;
 use super::coincide::input_steps;
 use super::settings::EVIDENCE_THRESHOLD;
 pub use as_given::AsGiven;
+pub use figure::{FOLDED_BINS, Folded, UnexplainedFigure};
 pub use fingerprint::{EquationTerm, Fingerprint, LawFunction, equation_with, with_shapes};
 use oscillation::Oscillation;
 pub use oscillation::{frequency_search_cost, lowest_frequency_over};
@@ -277,20 +279,6 @@ pub struct Unexplained {
     /// The evidence behind the fingerprint, for the command's figure.
     #[serde(skip)]
     pub figure: UnexplainedFigure,
-}
-
-/// What `unexplained.png` shows: each channel's whitened residual with the part the leading
-/// fingerprint explains, and each channel's spectrum of gains (the sinusoid's log-likelihood
-/// gain at each searched frequency).
-#[derive(Clone, Debug, Default)]
-pub struct UnexplainedFigure {
-    pub times: Vec<f64>,
-    pub channels: Vec<String>,
-    /// Stacked channel after channel, in noise σ.
-    pub residual: Vec<f64>,
-    pub explained: Vec<f64>,
-    /// Per channel: (frequencies [Hz], gains [nats]).
-    pub spectrum: Vec<(Vec<f64>, Vec<f64>)>,
 }
 
 /// Everything scored on one model's residuals: the fingerprints and the generic alternatives.
@@ -543,6 +531,7 @@ pub fn unexplained(
         spectrum: (0..ctx.channels.len())
             .map(|c| oscillation::spectrum(&ctx, c))
             .collect(),
+        folded: figure::folded(&ctx, &fingerprint, &candidates[0].residual),
     };
     let mut channels = Vec::new();
     let mut where_ = Vec::new();
