@@ -20,7 +20,7 @@ use crate::error::Error;
 use crate::motor::Term;
 use crate::motor::dictionary::{
     self, BALANCES, CURRENT_LIMIT, FUNCTIONS, N_FUNCTIONS, ODE_BALANCES, PERIODIC, RIPPLES,
-    STRIBECK, SUPPLY_RIPPLE, reads_harmonic, ripple_of,
+    STRIBECK, SUPPLY_RIPPLE, reads_frequency, reads_harmonic, ripple_of,
 };
 use crate::motor::terms::Law;
 use crate::parameter::ParamId;
@@ -348,6 +348,13 @@ fn fit_named(problem: &Problem, with: &Candidate, named: &NamedTerm) -> Result<C
         (None, Some(w)) => (law.shapes.harmonic, w, false),
         (None, None) => return fit_named_at(problem, with, named, None),
     };
+    // A law extending the one `with` holds keeps the shape that law already reads
+    // (`extended`): searched, every value tried would fit the same model.
+    if law_of(with)
+        .is_some_and(|held| with.added.iter().any(|a| a == "law") && reads(held, frequency))
+    {
+        return fit_named_at(problem, with, named, None);
+    }
     let at = |x: f64| {
         let mut law = law.clone();
         if frequency {
@@ -425,8 +432,21 @@ pub(super) fn law_of(fit: &Candidate) -> Option<&Law> {
     })
 }
 
-/// `held` with `more`'s functions as well; a shape (ω_s, k) `held` has no function of is
-/// taken from `more`.
+/// Whether `law` holds a function of time's frequency f (`frequency`) or of the angle's
+/// harmonic k (not).
+fn reads(law: &Law, frequency: bool) -> bool {
+    law.active.iter().any(|k| {
+        let f = k % N_FUNCTIONS;
+        if frequency {
+            reads_frequency(f)
+        } else {
+            reads_harmonic(f)
+        }
+    })
+}
+
+/// `held` with `more`'s functions as well; a shape (ω_s, k, f, I_lim) `held` has no function
+/// of is taken from `more`.
 fn extended(held: &Law, more: &Law) -> Law {
     let has = |law: &Law, fs: &[usize]| law.active.iter().any(|k| fs.contains(&(k % N_FUNCTIONS)));
     let mut law = held
@@ -438,6 +458,9 @@ fn extended(held: &Law, more: &Law) -> Law {
     let ripples: Vec<usize> = (0..N_FUNCTIONS).filter(|&f| reads_harmonic(f)).collect();
     if !has(held, &ripples) && has(more, &ripples) {
         law.shapes.harmonic = more.shapes.harmonic;
+    }
+    if !reads(held, true) && reads(more, true) {
+        law.shapes.frequency = more.shapes.frequency;
     }
     if !has(held, &[CURRENT_LIMIT]) && has(more, &[CURRENT_LIMIT]) {
         law.shapes.current_limit = more.shapes.current_limit;
@@ -471,6 +494,7 @@ pub fn fit_named_terms<'a>(
     let jobs: Vec<(&Candidate, &NamedTerm)> = named
         .iter()
         .flat_map(|n| bases.iter().map(move |b| (*b, n)))
+        .filter(|(with, n)| !adds_nothing(with, n))
         .collect();
     // A fit that fails (a stiff resonance far from the data) is no candidate, not an error of
     // the diagnosis.
@@ -482,6 +506,17 @@ pub fn fit_named_terms<'a>(
         .into_iter()
         .filter(|f| f.score - selected.score > EVIDENCE_THRESHOLD)
         .max_by(|a, b| a.score.total_cmp(&b.score)))
+}
+
+/// Whether `named` is a law whose every function the law `with` holds already has: the law it
+/// extends would be `with`'s own, refitted from another start.
+fn adds_nothing(with: &Candidate, named: &NamedTerm) -> bool {
+    match (&named.term, law_of(with)) {
+        (Term::Law(more), Some(held)) if with.added.iter().any(|a| a == "law") => {
+            more.active.iter().all(|k| held.active.contains(k))
+        }
+        _ => false,
+    }
 }
 
 impl NamedTerm {
