@@ -455,8 +455,7 @@ fn extended(held: &Law, more: &Law) -> Law {
     if !has(held, &[STRIBECK]) && has(more, &[STRIBECK]) {
         law.shapes.omega_s = more.shapes.omega_s;
     }
-    let ripples: Vec<usize> = (0..N_FUNCTIONS).filter(|&f| reads_harmonic(f)).collect();
-    if !has(held, &ripples) && has(more, &ripples) {
+    if !reads(held, false) && reads(more, false) {
         law.shapes.harmonic = more.shapes.harmonic;
     }
     if !reads(held, true) && reads(more, true) {
