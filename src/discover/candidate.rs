@@ -54,6 +54,8 @@ pub struct Candidate {
     pub log_evidence_laplace: f64,
     /// log L̂ − ½·d·ln N (less a searched start's multiplicity, [`Starts::search_penalty`]).
     pub score: f64,
+    /// The nats `score` pays for the grids its added terms' starts were the best of.
+    pub search_penalty: f64,
     /// Calibrated parameters at the MAP (physical values), keyed by the model's names.
     pub theta: BTreeMap<String, f64>,
     /// Added one-sided parameters the data do not hold away from their bound: the Laplace
@@ -218,6 +220,7 @@ pub fn fit_candidate_at(
         log_likelihood,
         log_evidence_laplace: map.log_evidence_laplace,
         score: log_likelihood - 0.5 * n_added as f64 * n.ln() - search_penalty,
+        search_penalty,
         map,
         theta,
         at_bound,

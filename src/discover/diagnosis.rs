@@ -276,7 +276,7 @@ pub fn assemble(
             left = unexplained(problem, &selected_fit, &none, &as_given)?;
         }
         // The law's functions were chosen at first order; through the ODE each must pay.
-        if let Some(fit) = prune_law(problem, &selected_fit)? {
+        if let Some(fit) = prune_law(&selected_fit)? {
             found = discovered(&fit, fit.score - before);
             selected_fit = fit;
             left = unexplained(problem, &selected_fit, &none, &as_given)?;

@@ -350,9 +350,7 @@ fn fit_named(problem: &Problem, with: &Candidate, named: &NamedTerm) -> Result<C
     };
     // A law extending the one `with` holds keeps the shape that law already reads
     // (`extended`): searched, every value tried would fit the same model.
-    if law_of(with)
-        .is_some_and(|held| with.added.iter().any(|a| a == "law") && reads(held, frequency))
-    {
+    if added_law(with).is_some_and(|held| reads(held, frequency)) {
         return fit_named_at(problem, with, named, None);
     }
     let at = |x: f64| {
@@ -390,13 +388,11 @@ fn fit_named_at(
     let search_penalty = named.search_penalty;
     let name = named.term.name().to_string();
     let mut added = with.added.clone();
-    let term = match (&named.term, law_of(with)) {
+    let term = match (&named.term, added_law(with)) {
         // A law named beside a fit that holds one already (the verdict after a law found more
         // in the same balance: the other half of a ripple's phase) extends that law; its
         // coefficients start at the fit's estimates, its shapes are kept where it has them.
-        (Term::Law(more), Some(held)) if with.added.contains(&name) => {
-            Term::Law(extended(held, more))
-        }
+        (Term::Law(more), Some(held)) => Term::Law(extended(held, more)),
         _ => {
             added.push(name.clone());
             named.term.clone()
@@ -430,6 +426,12 @@ pub(super) fn law_of(fit: &Candidate) -> Option<&Law> {
         Term::Law(law) => Some(law),
         _ => None,
     })
+}
+
+/// The law the diagnosis added to `fit`'s model, if one (not a law the user's model holds):
+/// a law named beside it extends it.
+fn added_law(fit: &Candidate) -> Option<&Law> {
+    law_of(fit).filter(|_| fit.added.iter().any(|a| a == "law"))
 }
 
 /// Whether `law` holds a function of time's frequency f (`frequency`) or of the angle's
@@ -510,10 +512,8 @@ pub fn fit_named_terms<'a>(
 /// Whether `named` is a law whose every function the law `with` holds already has: the law it
 /// extends would be `with`'s own, refitted from another start.
 fn adds_nothing(with: &Candidate, named: &NamedTerm) -> bool {
-    match (&named.term, law_of(with)) {
-        (Term::Law(more), Some(held)) if with.added.iter().any(|a| a == "law") => {
-            more.active.iter().all(|k| held.active.contains(k))
-        }
+    match (&named.term, added_law(with)) {
+        (Term::Law(more), Some(held)) => more.active.iter().all(|k| held.active.contains(k)),
         _ => false,
     }
 }

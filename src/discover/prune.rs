@@ -9,7 +9,6 @@ use crate::motor::Term;
 use crate::motor::dictionary::{self, N_FUNCTIONS, PHASE_PAIRS};
 use crate::motor::terms::Law;
 use crate::parameter::ParamId;
-use crate::study::Problem;
 
 use super::candidate::{Candidate, fit_candidate_at};
 use super::named::law_of;
@@ -27,19 +26,16 @@ use super::named::law_of;
 /// that replaced the weights took most of the diagnosis. A searched frequency's or harmonic's
 /// price is kept whatever is dropped: the grid was searched. `None` where `fit` holds no law
 /// of two or more such units, or none is dropped.
-pub fn prune_law(problem: &Problem, fit: &Candidate) -> Result<Option<Candidate>, Error> {
-    let n = problem.n_observations() as f64;
+pub fn prune_law(fit: &Candidate) -> Result<Option<Candidate>, Error> {
     let mut best: Option<Candidate> = None;
     loop {
         let current = best.as_ref().unwrap_or(fit);
         let Some(units) = law_of(current).map(units_of).filter(|u| u.len() > 1) else {
             break;
         };
-        let penalty =
-            current.log_likelihood - 0.5 * current.n_added as f64 * n.ln() - current.score;
         let reduced: Vec<Candidate> = units
             .par_iter()
-            .filter_map(|unit| without(current, unit, penalty).ok())
+            .filter_map(|unit| without(current, unit).ok())
             .collect();
         match reduced
             .into_iter()
@@ -74,7 +70,7 @@ fn units_of(law: &Law) -> Vec<Vec<usize>> {
 /// `fit` refitted with its law's functions `unit` removed, its terms as they were set (a lag's
 /// channel, the law's shapes), every parameter started at `fit`'s estimate, paying the same
 /// search price.
-fn without(fit: &Candidate, unit: &[usize], penalty: f64) -> Result<Candidate, Error> {
+fn without(fit: &Candidate, unit: &[usize]) -> Result<Candidate, Error> {
     let dropped: Vec<ParamId> = unit
         .iter()
         .map(|&k| ParamId::of_term("law", dictionary::key(k)))
@@ -100,5 +96,5 @@ fn without(fit: &Candidate, unit: &[usize], penalty: f64) -> Result<Candidate, E
         .filter(|(name, _)| !dropped.contains(&ParamId::parse(name)))
         .map(|(name, v)| (name.clone(), *v))
         .collect();
-    fit_candidate_at(problem, &fit.added, &start, penalty)
+    fit_candidate_at(problem, &fit.added, &start, fit.search_penalty)
 }
