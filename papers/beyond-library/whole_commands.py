@@ -4,12 +4,19 @@ independent-integrator cases: the runtime each printed (`runtime_s`), and, where
 discovered, σ after it (`fit_after.sigma`) over the record's own noise, the standard deviation
 of recording.csv − truth.csv per channel (the generator's noise-free truth beside each case).
 
-    whole_commands.py REPORTS_DIR CASES_DIR [CASES_DIR …]
+    whole_commands.py [--cases NAME,NAME…] REPORTS_DIR CASES_DIR [CASES_DIR …]
+
+With --cases, the runtime of each case named is printed too (a case quoted before and after a
+change, whatever its place in the run).
 
 REPORTS_DIR holds NAME.json for each case folder NAME found under the CASES_DIRs."""
 import csv, glob, json, math, os, statistics, sys
 
-reports, case_dirs = sys.argv[1], sys.argv[2:]
+args = sys.argv[1:]
+named = []
+if args and args[0] == "--cases":
+    named, args = args[1].split(","), args[2:]
+reports, case_dirs = args[0], args[1:]
 cases = {os.path.basename(os.path.dirname(d)): d for c in case_dirs for d in glob.glob(f"{c}/*/")}
 
 def own_noise(case):
@@ -32,6 +39,8 @@ print(f"{len(times)} whole commands: runtime max {times[-1][0]:.1f} s ({times[-1
       f"median {statistics.median(t for t, _ in times):.1f} s; over 30 s: "
       f"{sum(t > 30 for t, _ in times)}")
 print("slowest five: " + ", ".join(f"{name} {t:.1f} s" for t, name in reversed(times[-5:])))
+if named:
+    print("named: " + ", ".join(f"{name} {runs[name]['runtime_s']:.1f} s" for name in named if name in runs))
 print("\n| case | law's balance | σ_I after / own noise | σ_ω after / own noise | within 10% |")
 print("|---|---|---|---|---|")
 n = ok = 0
