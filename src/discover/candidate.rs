@@ -132,6 +132,18 @@ pub fn fit_candidate_started(
     warm: Option<&Candidate>,
     starts: &Starts,
 ) -> Result<Candidate, Error> {
+    let warms: Vec<&Candidate> = warm.into_iter().collect();
+    fit_candidate_warmed(base, added, &warms, starts)
+}
+
+/// As [`fit_candidate_started`] with several warm fits, each giving a start (its estimates
+/// over `starts`' values); the search runs from the one whose log density is highest.
+pub fn fit_candidate_warmed(
+    base: &Problem,
+    added: &[String],
+    warms: &[&Candidate],
+    starts: &Starts,
+) -> Result<Candidate, Error> {
     let mut problem = base.with_terms(added)?;
     for active in &mut problem.model.terms {
         let name = active.term.name();
@@ -153,15 +165,22 @@ pub fn fit_candidate_started(
             }
         }
     }
-    let mut start = starts.values.clone();
-    if let Some(w) = warm {
-        start.extend(w.theta.iter().map(|(k, v)| (k.clone(), *v)));
+    let mut start_values: Vec<BTreeMap<String, f64>> = warms
+        .iter()
+        .map(|w| {
+            let mut start = starts.values.clone();
+            start.extend(w.theta.iter().map(|(k, v)| (k.clone(), *v)));
+            start
+        })
+        .collect();
+    if start_values.is_empty() {
+        start_values.push(starts.values.clone());
     }
     let penalty = added
         .iter()
         .filter_map(|a| starts.search_penalty.get(a))
         .sum();
-    fit_candidate_at(problem, added, &start, penalty)
+    fit_candidate_among(problem, added, &start_values, penalty)
 }
 
 /// As [`fit_candidate`] on `problem`, the base with `added` already switched on (their
@@ -171,6 +190,16 @@ pub fn fit_candidate_at(
     problem: Problem,
     added: &[String],
     start: &BTreeMap<String, f64>,
+    search_penalty: f64,
+) -> Result<Candidate, Error> {
+    fit_candidate_among(problem, added, std::slice::from_ref(start), search_penalty)
+}
+
+/// As [`fit_candidate_at`], from the best of several sets of start values.
+fn fit_candidate_among(
+    problem: Problem,
+    added: &[String],
+    start: &[BTreeMap<String, f64>],
     search_penalty: f64,
 ) -> Result<Candidate, Error> {
     let mut posterior = problem.posterior(&ModelSettings::bm1())?;
@@ -234,19 +263,40 @@ pub fn fit_candidate_at(
 /// several starts across its support: the best one.
 fn best_map(
     posterior: &mut CalibrationPosterior,
-    known_values: &BTreeMap<String, f64>,
+    known_values: &[BTreeMap<String, f64>],
     long_record: bool,
     costly_solve: bool,
 ) -> Result<MapEstimate, Error> {
-    let mut start = posterior.initial_point()?;
-    let known = |name: &str| known_values.get(name).copied();
-    for (i, c) in posterior.calibrated().iter().enumerate() {
-        if let Some(value) = known(&c.name)
-            && c.support.interior(value)
-        {
-            start[i] = c.to_unconstrained(value);
+    let initial = posterior.initial_point()?;
+    let start_at = |values: &BTreeMap<String, f64>| {
+        let mut start = initial.clone();
+        for (i, c) in posterior.calibrated().iter().enumerate() {
+            if let Some(&value) = values.get(&c.name)
+                && c.support.interior(value)
+            {
+                start[i] = c.to_unconstrained(value);
+            }
+        }
+        start
+    };
+    let mut candidates: Vec<Vec<f64>> = known_values.iter().map(start_at).collect();
+    if candidates.is_empty() {
+        candidates.push(initial.clone());
+    }
+    // Several warm starts (a nearby fit's estimates, and the base's beside the law's
+    // coefficients) are told apart by their own log densities, one plain solve each: a search
+    // from a start far from the mode can stall in a valley thousands of nats below it.
+    let mut start = candidates.swap_remove(0);
+    if !candidates.is_empty() {
+        let mut best = posterior.log_density(&start).unwrap_or(f64::NEG_INFINITY);
+        for s in candidates {
+            let lp = posterior.log_density(&s).unwrap_or(f64::NEG_INFINITY);
+            if lp > best {
+                (best, start) = (lp, s);
+            }
         }
     }
+    let known = |name: &str| known_values.iter().find_map(|v| v.get(name).copied());
     let bounded: Vec<(usize, f64, f64)> = posterior
         .calibrated()
         .iter()

@@ -60,6 +60,7 @@ mod prune;
 mod screen;
 mod selection;
 mod settings;
+mod shape_search;
 mod state;
 mod ties;
 mod unexplained;

@@ -26,9 +26,10 @@ use crate::motor::terms::Law;
 use crate::parameter::ParamId;
 use crate::study::Problem;
 
-use super::candidate::{Candidate, Starts, fit_candidate_started};
+use super::candidate::{Candidate, Starts, fit_candidate_started, fit_candidate_warmed};
 use super::settings::EVIDENCE_THRESHOLD;
-use super::unexplained::{Fingerprint, frequency_search_cost, golden_max};
+use super::shape_search::best_shape;
+use super::unexplained::{Fingerprint, frequency_search_cost};
 
 /// The term a fingerprint names, with its settings and the parameter values it starts at.
 #[derive(Clone, Debug, PartialEq)]
@@ -330,14 +331,10 @@ fn law_key(k: usize) -> &'static str {
         .expect("the law declares every key of the dictionary")
 }
 
-/// Golden-section steps of a law's frequency search through the ODE: a cell of 1/T narrowed
-/// to 0.6%, a phase error of 0.006 of a period over the record.
-const FREQUENCY_STEPS: usize = 11;
-
 /// `named` fitted beside `with` (the selected terms, or none), started at `with`'s estimates
 /// and the fingerprint's; a frequency found by a grid search pays the grid's multiplicity, as
 /// in the ranking. A law whose frequency or harmonic is searched is fitted at each value
-/// tried, and at the best.
+/// tried (`shape_search`), and the best fit is kept.
 fn fit_named(problem: &Problem, with: &Candidate, named: &NamedTerm) -> Result<Candidate, Error> {
     let Term::Law(law) = &named.term else {
         return fit_named_at(problem, with, named, None);
@@ -368,13 +365,14 @@ fn fit_named(problem: &Problem, with: &Candidate, named: &NamedTerm) -> Result<C
         }
     };
     // The values tried lie within a quarter of the record's Fourier spacing of the start, where
-    // the coefficients hardly move: each fit continues from the fit at the start, not from the
+    // the coefficients hardly move: each fit continues from the best fit so far, not from the
     // fingerprint's regression (what bounds a fit that crawls is `MapSettings::ranking`'s cap).
-    let first = fit_named_at(problem, with, &at(start), None).ok();
-    let x = golden_max(start - width, start + width, FREQUENCY_STEPS, |x| {
-        fit_named_at(problem, with, &at(x), first.as_ref()).map_or(f64::NEG_INFINITY, |c| c.score)
+    let first = fit_named_at(problem, with, &at(start), None);
+    let best = best_shape(start, width, first.as_ref().ok().cloned(), |x, warm| {
+        fit_named_at(problem, with, &at(x), warm).ok()
     });
-    fit_named_at(problem, with, &at(x), first.as_ref())
+    // None only where every fit failed, the start's among them: its error says why.
+    best.map_or(first, Ok)
 }
 
 /// `named` fitted beside `with` at its settings as they are, its parameters started at
@@ -407,17 +405,25 @@ fn fit_named_at(
             .values
             .insert(ParamId::of_term(&name, key).to_string(), value);
     }
-    if let Some(warm) = warm {
-        let own = warm
-            .theta
-            .iter()
-            .filter(|(k, _)| ParamId::parse(k).is_of(&name));
-        starts.values.extend(own.map(|(k, v)| (k.clone(), *v)));
-    }
     if search_penalty > 0.0 {
-        starts.search_penalty.insert(name, search_penalty);
+        starts.search_penalty.insert(name.clone(), search_penalty);
     }
-    fit_candidate_started(problem, &added, Some(with), &starts)
+    // A fit of the same model at a nearby shape gives two starts: every parameter at its
+    // estimates, or `with`'s beside its law's coefficients. Each alone stalled on
+    // bearing_defect-690003, thousands of nats below the other on some shapes; the search
+    // runs from whichever starts higher.
+    let Some(warm) = warm else {
+        return fit_candidate_started(problem, &added, Some(with), &starts);
+    };
+    let mut with_law = with.clone();
+    with_law.theta = warm
+        .theta
+        .iter()
+        .filter(|(k, _)| ParamId::parse(k).is_of(&name))
+        .chain(&with.theta)
+        .map(|(k, v)| (k.clone(), *v))
+        .collect();
+    fit_candidate_warmed(problem, &added, &[warm, &with_law], &starts)
 }
 
 /// The law `fit`'s model holds, if one.

@@ -59,7 +59,6 @@ pub use figure::{FOLDED_BINS, Folded, UnexplainedFigure};
 pub use fingerprint::{EquationTerm, Fingerprint, LawFunction, equation_with, with_shapes};
 use oscillation::Oscillation;
 pub use oscillation::{frequency_search_cost, lowest_frequency_over};
-pub use regression::golden_max;
 use regression::{Explained, Projector, explain};
 pub use spans::Span;
 use spans::spans;
