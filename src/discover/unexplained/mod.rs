@@ -190,7 +190,13 @@ impl Context {
     }
 
     fn score(&self, b: &DMatrix<f64>, extra_penalty: f64) -> Scored {
-        let e = explain(&self.y, &self.projector.residualize(b));
+        self.score_residualized(&self.projector.residualize(b), extra_penalty)
+    }
+
+    /// [`Self::score`] of columns already residualized on the model's sensitivities (a caller
+    /// that needs them too, for the coefficients' sds).
+    fn score_residualized(&self, b_perp: &DMatrix<f64>, extra_penalty: f64) -> Scored {
+        let e = explain(&self.y, b_perp);
         let penalty = 0.5 * e.rank as f64 * self.ln_n + extra_penalty;
         Scored::new(e, penalty)
     }

@@ -73,9 +73,9 @@ pub(super) fn evidence(ctx: &Context, c: usize, shift: f64) -> Option<Evidence> 
         let (s, co) = (nu * phase[i]).sin_cos();
         (if j == 0 { s } else { co }) / ctx.sigma[c]
     });
-    let b = ctx.in_channel(c, &columns);
-    let scored = ctx.score(&b, (points as f64).ln());
-    let sds = coefficient_sds(&ctx.projector.residualize(&b));
+    let b_perp = ctx.projector.residualize(&ctx.in_channel(c, &columns));
+    let scored = ctx.score_residualized(&b_perp, (points as f64).ln());
+    let sds = coefficient_sds(&b_perp);
     let channel = &ctx.channels[c];
     let functions = ["sin", "cos"]
         .iter()
