@@ -131,7 +131,8 @@ enum Effect {
     MainsPickup { a: f64, f: f64, phase: f64 },
     /// A bearing's defect: a torque −a·sin(k·θ + φ) at a k that is not a whole number of
     /// periods per revolution (a ball-pass frequency over the shaft's, 2.2–5.8).
-    /// `--effects bearing_defect`.
+    /// `--effects bearing_defect`; `--effects gear_ripple` draws the same torque below once per
+    /// revolution (k 0.2–0.8: a load behind a gearbox, once per turn of its slower shaft).
     BearingDefect { a: f64, k: f64, phase: f64 },
     /// A tachogenerator's commutator ripple: ω read as ω·(1 + ε·sin(k·θ + φ)), k 1–3.
     /// `--effects tacho_ripple`.
@@ -241,6 +242,13 @@ impl Effect {
             "bearing_defect" => Effect::BearingDefect {
                 a: 1e-3,
                 k: rng.random_range(2.2..5.8),
+                phase: rng.random_range(0.0..2.0 * PI),
+            },
+            // A load behind a gearbox that ripples once per turn of its slower shaft: the
+            // angle's ripple below once per motor revolution (a reduction of 1.25 to 5).
+            "gear_ripple" => Effect::BearingDefect {
+                a: 1e-3,
+                k: rng.random_range(0.2..0.8),
                 phase: rng.random_range(0.0..2.0 * PI),
             },
             "tacho_ripple" => Effect::TachoRipple {
