@@ -98,35 +98,54 @@ pub(super) fn order_gain(theta: &[f64], y: &[f64], k: f64) -> f64 {
 
 #[cfg(test)]
 mod tests {
+    use rand::SeedableRng;
+    use rand_chacha::ChaCha8Rng;
+    use rand_distr::{Distribution, Normal};
+
     use super::*;
+
+    /// A whitened residual: a ripple 0.5·sin(k·θ + φ) in unit noise.
+    fn ripple_in_noise(theta: &[f64], k: f64, phase: f64, rng: &mut ChaCha8Rng) -> Vec<f64> {
+        let noise = Normal::new(0.0, 1.0).unwrap();
+        theta
+            .iter()
+            .map(|th| 0.5 * (k * th + phase).sin() + noise.sample(rng))
+            .collect()
+    }
+
+    fn revolutions(theta: &[f64]) -> f64 {
+        (theta[theta.len() - 1] - theta[0]) / (2.0 * std::f64::consts::PI)
+    }
+
+    /// The order the search finds in `y`, asserted within a quarter of the angle's Fourier
+    /// spacing 1/R of `k`.
+    fn found_near(theta: &[f64], y: &[f64], k: f64) -> Order {
+        let found = search_in(theta, &[y], 12.0).expect("enough revolutions");
+        assert!(
+            (found.k - k).abs() < 0.25 / revolutions(theta),
+            "{} vs {k}",
+            found.k
+        );
+        found
+    }
 
     #[test]
     fn an_order_between_whole_numbers_is_found_where_the_residual_has_it() {
         // A record spinning at a steady 200 rad/s for 0.5 s (about 16 revolutions) whose
-        // residual (unit noise, whitened) holds a ripple at 3.39 periods per revolution: the
-        // grid's 3 and 4 miss it by several of the angle's Fourier spacings (1/R), the search
-        // finds it within a quarter of one.
-        use rand::SeedableRng;
-        use rand_distr::{Distribution, Normal};
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
-        let noise = Normal::new(0.0, 1.0).unwrap();
+        // residual holds a ripple at 3.39 periods per revolution: the grid's 3 and 4 miss it
+        // by several of the angle's Fourier spacings (1/R), the search finds it within a
+        // quarter of one.
+        let mut rng = ChaCha8Rng::seed_from_u64(7);
         let times: Vec<f64> = (1..=501).map(|i| i as f64 * 1e-3).collect();
         let theta: Vec<f64> = times.iter().map(|t| 200.0 * t).collect();
-        let y: Vec<f64> = theta
-            .iter()
-            .map(|th| 0.5 * (3.39 * th + 0.7).sin() + noise.sample(&mut rng))
-            .collect();
-        let revolutions = (theta[500] - theta[0]) / (2.0 * std::f64::consts::PI);
-        let found = search_in(&theta, &[&y], 12.0).expect("16 revolutions are enough");
-        assert!(
-            (found.k - 3.39).abs() < 0.25 / revolutions,
-            "{} vs 3.39",
-            found.k
-        );
+        let y = ripple_in_noise(&theta, 3.39, 0.7, &mut rng);
+        let found = found_near(&theta, &y, 3.39);
+        let r = revolutions(&theta);
         // The price is ln of the grid's points: four per 1/R over [2/R, 12].
-        let points = ((12.0 - 2.0 / revolutions) * 4.0 * revolutions).floor() + 1.0;
+        let points = ((12.0 - 2.0 / r) * 4.0 * r).floor() + 1.0;
         assert!((found.price - points.ln()).abs() < 0.01, "{}", found.price);
         // Pure noise has its best order somewhere, but no gain near the ripple's.
+        let noise = Normal::new(0.0, 1.0).unwrap();
         let white: Vec<f64> = (0..501).map(|_| noise.sample(&mut rng)).collect();
         let ripple = order_gain(&theta, &y, found.k);
         let chance = order_gain(
@@ -138,7 +157,7 @@ mod tests {
         // Too few revolutions, or nothing sampled above two periods over the record: no search.
         let slow: Vec<f64> = times.iter().map(|t| 10.0 * t).collect();
         assert_eq!(search_in(&slow, &[&y], 12.0), None);
-        assert_eq!(search_in(&theta, &[&y], 2.0 / revolutions), None);
+        assert_eq!(search_in(&theta, &[&y], 2.0 / r), None);
     }
 
     #[test]
@@ -147,10 +166,7 @@ mod tests {
         // revolutions in 0.5 s) whose residual holds a ripple once per turn of a shaft geared
         // down 2.7 times (k = 0.37): its period in time stretches through the spin-up, so no
         // frequency holds it; in the angle the search finds it within a quarter of 1/R.
-        use rand::SeedableRng;
-        use rand_distr::{Distribution, Normal};
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
-        let noise = Normal::new(0.0, 1.0).unwrap();
+        let mut rng = ChaCha8Rng::seed_from_u64(11);
         let tau = 0.1;
         let theta: Vec<f64> = (1..=501)
             .map(|i| {
@@ -158,16 +174,7 @@ mod tests {
                 600.0 * (t - tau * (1.0 - (-t / tau).exp()))
             })
             .collect();
-        let y: Vec<f64> = theta
-            .iter()
-            .map(|th| 0.5 * (0.37 * th + 2.0).sin() + noise.sample(&mut rng))
-            .collect();
-        let revolutions = (theta[500] - theta[0]) / (2.0 * std::f64::consts::PI);
-        let found = search_in(&theta, &[&y], 12.0).expect("40 revolutions are enough");
-        assert!(
-            (found.k - 0.37).abs() < 0.25 / revolutions,
-            "{} vs 0.37",
-            found.k
-        );
+        let y = ripple_in_noise(&theta, 0.37, 2.0, &mut rng);
+        found_near(&theta, &y, 0.37);
     }
 }
