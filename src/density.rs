@@ -185,6 +185,10 @@ pub struct SolveCount {
     pub plain: u64,
     pub dual: u64,
     pub directions: u64,
+    /// The right-hand side's evaluations over those solves (each pass of a dual solve's
+    /// counted): the integrator's work, which a stiff corner of parameter space multiplies
+    /// where the number of solves does not show it.
+    pub rhs_evaluations: u64,
 }
 
 impl SolveCount {
@@ -203,6 +207,7 @@ impl std::ops::Add for SolveCount {
             plain: self.plain + o.plain,
             dual: self.dual + o.dual,
             directions: self.directions + o.directions,
+            rhs_evaluations: self.rhs_evaluations + o.rhs_evaluations,
         }
     }
 }
@@ -214,6 +219,7 @@ impl std::ops::Sub for SolveCount {
             plain: self.plain - o.plain,
             dual: self.dual - o.dual,
             directions: self.directions - o.directions,
+            rhs_evaluations: self.rhs_evaluations - o.rhs_evaluations,
         }
     }
 }
@@ -268,6 +274,15 @@ impl<P> Counted<P> {
             gradient_evaluations: 0,
             metric_evaluations: 0,
         }
+    }
+}
+
+impl<P: LogDensity> Counted<P> {
+    /// The work spent so far: gradient evaluations plus the integrator's right-hand-side
+    /// evaluations. Where the density integrates an ODE the second dominates and follows what
+    /// each gradient cost; for a closed-form density it is the gradients alone.
+    pub fn work(&self) -> u64 {
+        self.gradient_evaluations + self.inner.solves().rhs_evaluations
     }
 }
 

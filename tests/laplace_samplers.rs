@@ -54,6 +54,30 @@ fn a_banana_is_flagged_and_falls_back_to_nuts_unless_told_not_to() {
     assert!(run.max_rhat.is_finite() && run.min_ess_bulk > 0.0);
 }
 
+#[test]
+fn a_fallback_past_its_gradient_budget_stops_and_the_refused_sample_stands() {
+    let mut banana = Banana {
+        bend: 3.0,
+        width: 0.2,
+    };
+    let kept = run_sampler(&mut banana, &settings(false), "banana").unwrap();
+    // One gradient per transition on average: no NUTS transition spends less, so the budget
+    // is spent before the last, and what stands is the sample k̂ refused, as it was drawn.
+    let budgeted = RunSettings {
+        fallback_budget: Some(1),
+        ..settings(true)
+    };
+    let run = run_sampler(&mut banana, &budgeted, "banana").unwrap();
+    assert!(run.fallback_stopped && !run.fell_back);
+    assert_eq!(run.sampler, "laplace-is");
+    assert_eq!(run.khat, kept.khat);
+    assert_eq!(run.chains.len(), kept.chains.len());
+    for (a, b) in run.chains.iter().zip(&kept.chains) {
+        assert_eq!(a.draws, b.draws);
+    }
+    assert!(!kept.fallback_stopped);
+}
+
 /// The independence sampler with its default warm-up (40 transitions for each of its 8
 /// proposal shapes), 4 chains of `draws`.
 fn independence(fallback: bool, draws: usize) -> RunSettings {

@@ -193,32 +193,42 @@ fn laplace_evidence_of_bm1_agrees_with_importance_sampling() {
 
 #[test]
 fn solves_are_counted_where_the_cache_misses_a_gradient_with_its_directions() {
-    use motorcal::density::SolveCount;
+    use motorcal::density::{Counted, SolveCount};
     let mut searched = paper_posterior(&ModelSettings::bm2(3), 1);
     let mut x = searched.initial_point().unwrap();
     // A clone is a new evaluator: it counts from zero.
     let mut post = searched.clone();
     assert_eq!(post.solves(), SolveCount::default());
-    let count = |plain, dual| SolveCount {
-        plain,
-        dual,
-        directions: dual,
-    };
+    // The solves by kind; the integrator's work is checked beside them.
+    let kinds = |c: SolveCount| (c.plain, c.dual, c.directions);
     // The clone keeps the cache, not the count: a new R (index 0) makes the first solve.
     x[0] *= 1.001;
     post.log_density(&x).unwrap();
-    assert_eq!(post.solves(), count(1, 0));
-    // Only a coefficient moves: the cached solve serves it.
+    assert_eq!(kinds(post.solves()), (1, 0, 0));
+    let one_plain = post.solves().rhs_evaluations;
+    assert!(one_plain > 0);
+    // Only a coefficient moves: the cached solve serves it, at no work.
     let last = x.len() - 1;
     x[last] += 0.1;
     post.log_density(&x).unwrap();
-    assert_eq!(post.solves(), count(1, 0));
+    assert_eq!(kinds(post.solves()), (1, 0, 0));
+    assert_eq!(post.solves().rhs_evaluations, one_plain);
     let mut grad = vec![0.0; x.len()];
     post.log_density_and_gradient(&x, &mut grad).unwrap();
-    assert_eq!(post.solves(), count(1, 1));
+    assert_eq!(kinds(post.solves()), (1, 1, 1));
+    // One calibrated parameter, one dual pass: it takes the plain solve's steps (the step
+    // control sees real parts only), so the same right-hand sides.
+    assert_eq!(post.solves().rhs_evaluations, 2 * one_plain);
     x[0] *= 1.001;
     post.log_density(&x).unwrap();
-    assert_eq!(post.solves(), count(2, 1));
+    assert_eq!(kinds(post.solves()), (2, 1, 1));
+    // A chain's work (what a run's work budget counts): its gradients and the integrator's
+    // right-hand sides.
+    let mut counted = Counted::new(searched.clone());
+    x[0] *= 1.001;
+    counted.log_density_and_gradient(&x, &mut grad).unwrap();
+    assert_eq!(counted.work(), 1 + counted.solves().rhs_evaluations);
+    assert!(counted.work() > 1);
 }
 
 /// A diagnosis's sampled fits start from the ranking's MAP search (`MapSearch::Ranking`), which

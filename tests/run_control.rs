@@ -1,6 +1,6 @@
 //! What a caller controls of a run beside its settings (`RunControl`, which the Python bindings
-//! use): the stop flag ends the chains with `STOPPED`, and keeping the warm-up's draws changes
-//! no draw.
+//! use): the stop flag ends the chains with `STOPPED`, a work budget ends a chain that
+//! spent it with `BUDGET_SPENT`, and keeping the warm-up's draws changes no draw.
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
@@ -9,7 +9,9 @@ use motorcal::sampler::adapt::{DualAveragingSettings, StepSizeAdaptation};
 use motorcal::sampler::metric::{Metric, MetricKind};
 use motorcal::sampler::nuts::{Nuts, NutsSettings};
 use motorcal::sampler::targets::Gaussian;
-use motorcal::sampler::{ChainOutput, ChainSettings, RunControl, STOPPED, run_chains_until};
+use motorcal::sampler::{
+    BUDGET_SPENT, ChainOutput, ChainSettings, RunControl, STOPPED, run_chains_until,
+};
 
 const WARMUP: usize = 40;
 
@@ -62,6 +64,7 @@ fn keeping_the_warmup_changes_no_draw() {
         stop: Some(&unset),
         save_warmup: true,
         transitions: Some(&transitions),
+        work_budget: None,
     })
     .unwrap();
     // Every chain's every transition counted, for a caller's progress display.
@@ -79,4 +82,30 @@ fn keeping_the_warmup_changes_no_draw() {
         let first = b.warmup_records[0].step_size;
         assert!(b.warmup_records.iter().any(|r| r.step_size != first));
     }
+}
+
+#[test]
+fn a_chain_past_its_work_budget_ends_the_run_and_one_within_it_draws_as_without() {
+    let plain = nuts(RunControl::default()).unwrap();
+    // On a closed-form target a chain's work is its gradients.
+    let spent = |o: &ChainOutput| o.warmup.gradient_evaluations + o.sampling.gradient_evaluations;
+    let most = plain.iter().map(spent).max().unwrap();
+    let least = plain.iter().map(spent).min().unwrap();
+    // A budget every chain stays within moves no draw.
+    let within = nuts(RunControl {
+        work_budget: Some(most + 1),
+        ..RunControl::default()
+    })
+    .unwrap();
+    for (a, b) in plain.iter().zip(&within) {
+        assert_eq!(a.draws, b.draws);
+    }
+    // Half of what the thriftiest chain spent ends the run, as a fatal error.
+    let err = nuts(RunControl {
+        work_budget: Some(least / 2),
+        ..RunControl::default()
+    })
+    .unwrap_err();
+    assert_eq!(err.message, BUDGET_SPENT);
+    assert!(!err.recoverable);
 }

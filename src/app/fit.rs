@@ -101,6 +101,12 @@ pub struct RunArgs {
     /// default: fall back to NUTS).
     #[arg(long)]
     pub no_fallback: bool,
+    /// laplace-is: gradients per transition its NUTS fallback may spend on average, per
+    /// chain, each counted at what the chain's first cost in the integrator's work; a chain
+    /// past it stops the fallback and the importance sample with the lower k̂ stands
+    /// (diagnose's fits: 16). Default: no limit.
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+    pub fallback_budget: Option<u64>,
 }
 
 impl RunArgs {
@@ -111,6 +117,7 @@ impl RunArgs {
         run.save_adaptation = self.save_adaptation.clone();
         run.load_adaptation = self.load_adaptation.clone();
         run.fallback = !self.no_fallback;
+        run.fallback_budget = self.fallback_budget;
         run
     }
 }
@@ -186,6 +193,9 @@ pub struct FitReport {
     pub khat: Option<f64>,
     /// laplace-is, independence: k̂ above the sampler's line (0.7, 0.5) and NUTS drew instead.
     pub fell_back: bool,
+    /// laplace-is: NUTS was to draw instead but spent `--fallback-budget`; the importance
+    /// sample with the lower k̂ stands.
+    pub fallback_stopped: bool,
     pub wall_seconds: Option<f64>,
     pub outputs: Vec<String>,
     /// What the plausibility check found, when `--force` went on regardless.
@@ -256,6 +266,7 @@ pub fn fit(options: &FitOptions) -> Result<FitReport, AppError> {
         divergences: None,
         khat: None,
         fell_back: false,
+        fallback_stopped: false,
         wall_seconds: None,
         outputs: Vec::new(),
         implausible,
@@ -273,6 +284,7 @@ pub fn fit(options: &FitOptions) -> Result<FitReport, AppError> {
         report.divergences = Some(run.divergences);
         report.khat = run.khat;
         report.fell_back = run.fell_back;
+        report.fallback_stopped = run.fallback_stopped;
         report.wall_seconds = Some(run.wall_seconds);
         report.summaries = run.summaries;
     }
@@ -403,7 +415,7 @@ pub fn format_report(report: &FitReport) -> String {
             report.wall_seconds.unwrap_or(f64::NAN)
         ));
         if let Some(khat) = report.khat {
-            out.push_str(&khat_line(khat, report.fell_back));
+            out.push_str(&khat_line(khat, report.fell_back, report.fallback_stopped));
         }
         out.push_str(&super::summarize::format_table(&report.summaries));
     }
@@ -420,7 +432,7 @@ pub fn format_report(report: &FitReport) -> String {
 }
 
 /// What k̂ says about the Laplace approximation, and what the run did about it.
-pub fn khat_line(khat: f64, fell_back: bool) -> String {
+pub fn khat_line(khat: f64, fell_back: bool, fallback_stopped: bool) -> String {
     use crate::diagnostics::{KHAT_GOOD, KHAT_UNRELIABLE};
     let verdict = if khat <= KHAT_GOOD {
         "the Laplace approximation is good"
@@ -431,6 +443,8 @@ pub fn khat_line(khat: f64, fell_back: bool) -> String {
     };
     let action = if fell_back {
         "; NUTS drew instead"
+    } else if fallback_stopped {
+        "; NUTS, to draw instead, spent its --fallback-budget: these draws stand"
     } else if khat > KHAT_UNRELIABLE || khat.is_nan() {
         "; kept as asked (--no-fallback)"
     } else {

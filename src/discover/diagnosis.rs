@@ -482,6 +482,14 @@ fn sampled_fits(
             &run,
             &format!("{}: {}", stage.name(), model.label()),
         )?;
+        if fit.run.fallback_stopped {
+            diagnosis.notes.push(format!(
+                "the {} fit's NUTS fallback spent its budget: its summary is the Laplace \
+                 approximation's (k̂ {:.2}, refused for weighing)",
+                stage.name(),
+                fit.run.khat.unwrap_or(f64::NAN)
+            ));
+        }
         diagnosis
             .convergence
             .insert(stage.name().to_string(), Convergence::of(&fit.run));

@@ -86,6 +86,10 @@ pub struct Convergence {
     pub khat: Option<f64>,
     /// Whether k̂ above the line of [`khat_threshold`] sent the fit to NUTS.
     pub fell_back: bool,
+    /// Whether that NUTS run spent its budget ([`FALLBACK_GRADIENTS_PER_TRANSITION`]) and the
+    /// importance sample with the lower k̂ stands, `khat` its own: a summary to read as the
+    /// Laplace approximation's.
+    pub fallback_stopped: bool,
 }
 
 impl Convergence {
@@ -98,6 +102,7 @@ impl Convergence {
             wall_s: run.wall_seconds,
             khat: run.khat,
             fell_back: run.fell_back,
+            fallback_stopped: run.fallback_stopped,
         }
     }
 }
@@ -128,6 +133,20 @@ pub fn sample(
     Ok(SampledFit { posterior, run })
 }
 
+/// What a diagnosis's NUTS fallback may spend per transition on average, per chain, in
+/// gradients at the integrator's work of one at the MAP, before the importance sample with the
+/// lower k̂ stands instead (`RunSettings::fallback_budget`). Where the Laplace or the windowed
+/// metric captures the posterior, NUTS's trees are 2–3 levels deep (7 leapfrog steps a draw on
+/// compliant_coupling-740010's fit after, dense NUTS with Stan's windows); 16, a level deeper
+/// on average over warm-up and draws, is room for a posterior a few times longer than its
+/// metric says. A fallback that needs more is one whose geometry neither metric holds — a
+/// term's parameter the record cannot pin, a ridge — where its draws would not be trusted
+/// either, and where it cost minutes: a dead compliant coupling beside the law on
+/// gear_ripple-730002 took a diagnosis to 487 s, and `fit --sampler laplace-is` on that model
+/// 807 s (papers/beyond-library.md, session 8). The bound is the model's own cost: 4 × 1500 ×
+/// 16 gradients at the mode's price, which a model dear to solve makes long still.
+pub const FALLBACK_GRADIENTS_PER_TRANSITION: u64 = 16;
+
 /// `laplace-is` with `run`'s chains × draws proposals, kept where k̂ is below the line at
 /// which a Pareto-smoothed estimate from that many weights is reliable, min(1 − 1/log₁₀ S, 0.7)
 /// (Vehtari et al. 2024, eq. 13: 0.697 at diagnose's 4 × 500); above it, a second, wider
@@ -148,6 +167,7 @@ fn importance_or_sampler(
         fallback: true,
         fallback_above: khat_threshold(run.chains * run.chain.draws),
         defensive_proposal: true,
+        fallback_budget: Some(FALLBACK_GRADIENTS_PER_TRANSITION),
         // The fit starts at a candidate's MAP, found by the ranking's search.
         map_search: MapSearch::Ranking,
         // The run's warm-up is NUTS's; importance sampling's is its own recentring (BM2 fits

@@ -182,6 +182,7 @@ impl From<CostRecord> for RunCost {
                 plain: r.plain_solves,
                 dual: r.dual_solves,
                 directions: r.solve_directions,
+                ..SolveCount::default()
             },
             min_ess_per_solve: r.min_ess_per_solve,
         }
@@ -249,6 +250,7 @@ pub(crate) mod tests {
             log_evidence_laplace: 0.0,
             khat: None,
             fell_back: false,
+            fallback_stopped: false,
         }
     }
 
@@ -287,11 +289,13 @@ pub(crate) mod tests {
             plain: 10,
             dual: 20,
             directions: 20,
+            ..SolveCount::default()
         };
         r.sampling.solves = SolveCount {
             plain: 500,
             dual: 0,
             directions: 0,
+            ..SolveCount::default()
         };
         let cost = RunCost::of(&r, false);
         assert_eq!(cost.solves.equivalents(), 10 + 20 * 2 + 500);

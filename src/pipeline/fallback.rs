@@ -4,7 +4,9 @@
 
 use std::time::Instant;
 
+use crate::density::{Counted, LogDensity};
 use crate::diagnostics::KHAT_UNRELIABLE;
+use crate::sampler::BUDGET_SPENT;
 
 use super::{Error, Fittable, MetricAdaptation, PhaseCost, RunOutput, RunSettings, SamplerKind};
 
@@ -18,6 +20,12 @@ pub(super) fn falls_back(khat: f64, settings: &RunSettings, ceiling: f64) -> boo
 /// NUTS with a dense metric on `posterior` (tuned in Stan's windows where k̂ > 0.7, the Laplace one below), from the settings' chains,
 /// draws and seed. Its record keeps `khat`, says `fell_back`, adds `map` (the Laplace sampler's
 /// MAP) to its own, and counts `spent` (all the Laplace sampler drew) in its warm-up.
+///
+/// With `settings.fallback_budget` and a `refused` sample to return to, each chain may spend
+/// that many gradients per transition on average, each at the integrator's work of a gradient
+/// at the `mode`; where one spends more, the fallback ends and `refused` stands, marked
+/// [`RunOutput::fallback_stopped`].
+#[allow(clippy::too_many_arguments)]
 pub(super) fn nuts_instead<P: Fittable>(
     posterior: &P,
     settings: &RunSettings,
@@ -26,6 +34,7 @@ pub(super) fn nuts_instead<P: Fittable>(
     map: PhaseCost,
     spent: PhaseCost,
     started: Instant,
+    refused: Option<(RunOutput, &[f64])>,
 ) -> Result<RunOutput, Error> {
     // Where k̂ > 0.7 (or none could be fitted) the Laplace covariance is no metric to trust
     // either: NUTS re-estimates it in Stan's windows, with their warm-up. Between a stricter
@@ -38,17 +47,38 @@ pub(super) fn nuts_instead<P: Fittable>(
     } else {
         MetricAdaptation::Windows
     };
+    let warmup = super::default_warmup(SamplerKind::NutsDense, metric_adaptation);
+    let transitions = (warmup + settings.chain.draws) as u64;
+    let (refused, mode) = refused.unzip();
+    let work_budget = match (settings.fallback_budget, mode) {
+        (Some(per_transition), Some(mode)) => {
+            Some(per_transition * transitions * gradient_work(posterior, mode)?)
+        }
+        _ => None,
+    };
     let nuts = RunSettings {
         sampler: SamplerKind::NutsDense,
         chain: crate::sampler::ChainSettings {
-            warmup: super::default_warmup(SamplerKind::NutsDense, metric_adaptation),
+            warmup,
             ..settings.chain.clone()
         },
         metric_adaptation,
+        work_budget,
         ..settings.clone()
     };
     let mut posterior = posterior.clone();
-    let fallback = super::run_sampler(&mut posterior, &nuts, &format!("{label} fallback"))?;
+    let fallback = match super::run_sampler(&mut posterior, &nuts, &format!("{label} fallback")) {
+        Ok(run) => run,
+        Err(Error::Numerical(message)) if message == BUDGET_SPENT => {
+            let refused = refused.expect("a budget is set only with a sample to return to");
+            return Ok(RunOutput {
+                fallback_stopped: true,
+                wall_seconds: started.elapsed().as_secs_f64(),
+                ..refused
+            });
+        }
+        Err(e) => return Err(e),
+    };
     Ok(RunOutput {
         khat: Some(khat),
         fell_back: true,
@@ -57,4 +87,16 @@ pub(super) fn nuts_instead<P: Fittable>(
         wall_seconds: started.elapsed().as_secs_f64(),
         ..fallback
     })
+}
+
+/// The integrator's work of one gradient of `posterior` at `x` ([`Counted::work`]). A clone
+/// keeps its original's cached solves, which may hold `x`: the probe goes one representable
+/// number above it in every coordinate, where the solve takes the same steps and no cache
+/// serves it.
+fn gradient_work<P: Fittable>(posterior: &P, x: &[f64]) -> Result<u64, Error> {
+    let mut probe = Counted::new(posterior.clone());
+    let beside: Vec<f64> = x.iter().map(|v| v.next_up()).collect();
+    let mut gradient = vec![0.0; x.len()];
+    probe.log_density_and_gradient(&beside, &mut gradient)?;
+    Ok(probe.work())
 }

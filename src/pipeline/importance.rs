@@ -81,6 +81,7 @@ pub(super) fn laplace_is<P: Fittable>(
     };
     let mut spent = PhaseCost::default();
     let mut first_khat = None;
+    let mut refused = None;
     let mut map_cost = map_cost;
     for &((df, scale), seed) in attempts {
         let proposal = laplace
@@ -107,17 +108,27 @@ pub(super) fn laplace_is<P: Fittable>(
             ..finish_run(settings.sampler.name(), run.chains, map, started)
         };
         output.min_ess_bulk = output.min_ess_bulk.min(weights_ess);
+        // A proposal refused before is counted in the warm-up of the one kept.
+        let own = output.warmup + output.sampling;
+        output.warmup = spent + output.warmup;
         if !falls_back(khat, settings, f64::INFINITY) {
-            // A proposal refused before is counted in the warm-up of the one kept.
-            output.warmup = spent + output.warmup;
             return Ok(output);
         }
-        spent = spent + output.warmup + output.sampling;
+        spent = spent + own;
         first_khat.get_or_insert(khat);
         map_cost = output.map;
+        // The refused sample with the lower k̂ is what stands if the fallback stops at its
+        // budget (a k̂ that could not be fitted, NaN, is never the lower).
+        let lower = refused.as_ref().and_then(|r: &RunOutput| r.khat);
+        if refused.is_none() || (khat.is_finite() && !lower.is_some_and(|lower| lower <= khat)) {
+            refused = Some(output);
+        }
     }
     let khat = first_khat.unwrap_or(f64::NAN);
-    nuts_instead(posterior, settings, label, khat, map_cost, spent, started)
+    let refused = refused.map(|r| (r, map.x.as_slice()));
+    nuts_instead(
+        posterior, settings, label, khat, map_cost, spent, started, refused,
+    )
 }
 
 /// The Laplace approximation's marginal in the first `leading` coordinates: N(x̂_θ, (H⁻¹)_θθ).

@@ -97,7 +97,9 @@ pub(super) fn independence<P: Fittable>(
                     bar.abandon_with_message(format!("k̂ {khat:.2}: NUTS instead"));
                 }
             }
-            nuts_instead(posterior, settings, label, khat, map_cost, warmup, started)
+            nuts_instead(
+                posterior, settings, label, khat, map_cost, warmup, started, None,
+            )
         }
     }
 }

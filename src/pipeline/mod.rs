@@ -80,6 +80,11 @@ pub struct RunOutput {
     /// laplace-is, independence: k̂ said the Laplace approximation cannot be trusted and NUTS
     /// drew instead.
     pub fell_back: bool,
+    /// laplace-is: NUTS was to draw instead, but a chain spent the fallback's gradient budget
+    /// ([`RunSettings::fallback_budget`]), and the importance sample with the lower k̂ stands:
+    /// draws an approximation k̂ refused for weighing, kept because nothing better was had
+    /// within the budget. Its phases do not count the stopped NUTS run (`wall_seconds` does).
+    pub fallback_stopped: bool,
 }
 
 impl RunOutput {
@@ -188,12 +193,13 @@ where
 }
 
 /// What the settings ask of the chains beside their length: the stop flag, the warm-up's
-/// draws, the transition count.
+/// draws, the transition count, the work budget.
 fn run_control(settings: &RunSettings) -> RunControl<'_> {
     RunControl {
         stop: settings.stop.as_deref(),
         save_warmup: settings.save_warmup,
         transitions: settings.transitions.as_deref(),
+        work_budget: settings.work_budget,
     }
 }
 
@@ -255,6 +261,7 @@ pub fn finish_run(
         log_evidence_laplace: map.log_evidence_laplace,
         khat: None,
         fell_back: false,
+        fallback_stopped: false,
         summaries,
         chains,
     }

@@ -213,6 +213,16 @@ pub struct RunSettings {
     /// more, from a wider Student-t with heavier tails ([`super::importance::DEFENSIVE_SHAPE`]),
     /// before NUTS; its own k̂ judges it by the same line.
     pub defensive_proposal: bool,
+    /// laplace-is: the gradients per transition that its NUTS fallback may spend on average,
+    /// per chain (warm-up and draws), each at the cost of a gradient at the MAP in the
+    /// integrator's work ([`crate::density::Counted::work`]); a chain past it ends the
+    /// fallback, and the importance sample with the lower k̂ stands, its record saying so
+    /// ([`super::RunOutput::fallback_stopped`]). `None` lets the fallback run to its end.
+    pub fallback_budget: Option<u64>,
+    /// The work each chain may spend in all, warm-up and sampling
+    /// ([`crate::sampler::RunControl::work_budget`]); a chain past it ends the run with
+    /// [`crate::sampler::BUDGET_SPENT`]. `None`: no limit.
+    pub work_budget: Option<u64>,
     /// The MAP search the run starts from.
     #[serde(skip)]
     pub map_search: MapSearch,
@@ -260,6 +270,8 @@ impl Default for RunSettings {
             fallback: true,
             fallback_above: crate::diagnostics::KHAT_UNRELIABLE,
             defensive_proposal: false,
+            fallback_budget: None,
+            work_budget: None,
             map_search: MapSearch::Precise,
         }
     }

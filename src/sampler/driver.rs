@@ -155,6 +155,9 @@ where
 /// The message of a run stopped by its stop flag.
 pub const STOPPED: &str = "stopped on request";
 
+/// The message of a chain that spent [`RunControl::work_budget`].
+pub const BUDGET_SPENT: &str = "a chain spent its gradient budget";
+
 /// What a caller asks of a run beside its settings: a flag that stops it, and whether the
 /// warm-up's draws are kept too. Neither changes a draw.
 #[derive(Clone, Copy, Debug, Default)]
@@ -166,6 +169,13 @@ pub struct RunControl<'a> {
     /// Counts every chain's transitions, warm-up and sampling, for a caller's own progress
     /// display (the Python bindings draw theirs from it).
     pub transitions: Option<&'a AtomicUsize>,
+    /// The work each chain may spend, warm-up and sampling together ([`Counted::work`]:
+    /// gradients plus the integrator's right-hand sides), checked between transitions: a
+    /// chain past it ends with the fatal error [`BUDGET_SPENT`]. In the integrator's work, not
+    /// gradients alone, because a stiff corner of parameter space makes each gradient many
+    /// times dearer; in counts, not time, so that whether a run ends early is the same on
+    /// every machine and thread count.
+    pub work_budget: Option<u64>,
 }
 
 /// One chain's place in a run.
@@ -194,12 +204,24 @@ where
     warm_up(density, kernel, adaptation, rng, run)?.sample()
 }
 
-/// Ends a run whose stop flag is set.
-fn check(control: &RunControl<'_>) -> Result<(), DensityError> {
-    match control.stop {
-        Some(flag) if flag.load(Ordering::Relaxed) => Err(DensityError::fatal(STOPPED)),
-        _ => Ok(()),
+/// Ends a run whose stop flag is set, or a chain past its gradient budget.
+fn check<P: LogDensity>(
+    control: &RunControl<'_>,
+    density: &Counted<P>,
+) -> Result<(), DensityError> {
+    if control
+        .stop
+        .is_some_and(|flag| flag.load(Ordering::Relaxed))
+    {
+        return Err(DensityError::fatal(STOPPED));
     }
+    if control
+        .work_budget
+        .is_some_and(|budget| density.work() >= budget)
+    {
+        return Err(DensityError::fatal(BUDGET_SPENT));
+    }
+    Ok(())
 }
 
 /// A chain at the end of its warm-up, its kernel adapted and frozen, before its first draw:
@@ -258,7 +280,7 @@ where
     let mut constrained = Vec::new();
     let (mut warmup_draws, mut warmup_records) = (Vec::new(), Vec::new());
     for iteration in 0..settings.warmup {
-        check(&control)?;
+        check(&control, &density)?;
         let info = kernel.step(&mut density, &mut state, rng.borrow_mut())?;
         divergences_warmup += info.divergent as usize;
         if control.save_warmup {
@@ -335,7 +357,7 @@ where
         let mut last_step_size = f64::NAN;
         let sampling_watch = Stopwatch::start();
         for i in 0..settings.draws {
-            check(&control)?;
+            check(&control, &density)?;
             let info = kernel.step(&mut density, &mut state, rng.borrow_mut())?;
             divergences += info.divergent as usize;
             accept_sum += info.accept_stat;

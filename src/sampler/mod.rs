@@ -27,8 +27,8 @@ pub mod welford;
 
 pub use cost::PhaseCost;
 pub use driver::{
-    ChainOutput, ChainSettings, DrawRecord, RunControl, STOPPED, WarmChain, run_chain, run_chains,
-    run_chains_until, sample_chains, warm_up_chains,
+    BUDGET_SPENT, ChainOutput, ChainSettings, DrawRecord, RunControl, STOPPED, WarmChain,
+    run_chain, run_chains, run_chains_until, sample_chains, warm_up_chains,
 };
 
 use rand_chacha::ChaCha8Rng;
