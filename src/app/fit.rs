@@ -102,9 +102,9 @@ pub struct RunArgs {
     #[arg(long)]
     pub no_fallback: bool,
     /// laplace-is: gradients per transition its NUTS fallback may spend on average, per
-    /// chain, each counted at what the chain's first cost in the integrator's work; a chain
-    /// past it stops the fallback and the importance sample with the lower k̂ stands
-    /// (diagnose's fits: 16). Default: no limit.
+    /// chain, each priced at the integrator's work of one gradient at the MAP; a chain past it
+    /// stops the fallback and the importance sample with the lower k̂ stands (diagnose's fits:
+    /// 16). Default: no limit.
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
     pub fallback_budget: Option<u64>,
 }
