@@ -222,6 +222,21 @@ fn impossible_options_are_refused_before_any_work() {
     assert_clean_failure(&run(&["--chains", "0"]), &["--chains 0"]);
     assert_clean_failure(&run(&["--draws", "100", "--keep", "200"]), &["keep 200"]);
     assert_clean_failure(&run(&["--threads", "0"]), &["--threads 0"]);
+    // A budget for a fallback that will not happen.
+    assert_clean_failure(
+        &run(&["--sampler", "nuts-dense", "--fallback-budget", "16"]),
+        &["--fallback-budget 16", "laplace-is"],
+    );
+    assert_clean_failure(
+        &run(&[
+            "--sampler",
+            "laplace-is",
+            "--no-fallback",
+            "--fallback-budget",
+            "16",
+        ]),
+        &["--fallback-budget 16", "off"],
+    );
 }
 
 #[test]

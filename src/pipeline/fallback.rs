@@ -64,6 +64,8 @@ pub(super) fn nuts_instead<P: Fittable>(
         },
         metric_adaptation,
         work_budget,
+        // NUTS itself does not fall back.
+        fallback_budget: None,
         ..settings.clone()
     };
     let mut posterior = posterior.clone();

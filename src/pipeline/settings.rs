@@ -285,6 +285,23 @@ impl RunSettings {
         if self.threads == Some(0) {
             return Err(Error::setting("threads", 0, "need at least one thread"));
         }
+        if let Some(budget) = self.fallback_budget {
+            let why = if budget == 0 {
+                Some("a fallback needs at least one gradient per transition")
+            } else if !matches!(
+                self.sampler,
+                SamplerKind::LaplaceIs | SamplerKind::CollapsedIs
+            ) {
+                Some("only laplace-is and collapsed-is fall back within a budget")
+            } else if !self.fallback {
+                Some("the fallback is off")
+            } else {
+                None
+            };
+            if let Some(why) = why {
+                return Err(Error::setting("fallback_budget", budget, why));
+            }
+        }
         self.chain.validate().map_err(|e| {
             Error::Settings(crate::error::SettingError {
                 name: "keep/draws".into(),
