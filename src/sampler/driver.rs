@@ -156,10 +156,11 @@ where
 pub const STOPPED: &str = "stopped on request";
 
 /// The message of a chain that spent [`RunControl::work_budget`].
-pub const BUDGET_SPENT: &str = "a chain spent its gradient budget";
+pub const BUDGET_SPENT: &str = "a chain spent its work budget";
 
-/// What a caller asks of a run beside its settings: a flag that stops it, and whether the
-/// warm-up's draws are kept too. Neither changes a draw.
+/// What a caller asks of a run beside its settings: a flag that stops it, whether the
+/// warm-up's draws are kept too, a count of transitions, and the work a chain may spend. None
+/// changes a draw; the flag and the budget may end the run.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct RunControl<'a> {
     /// Checked between transitions: once set, the run ends with the fatal error [`STOPPED`].
@@ -204,7 +205,7 @@ where
     warm_up(density, kernel, adaptation, rng, run)?.sample()
 }
 
-/// Ends a run whose stop flag is set, or a chain past its gradient budget.
+/// Ends a run whose stop flag is set, or a chain past its work budget.
 fn check<P: LogDensity>(
     control: &RunControl<'_>,
     density: &Counted<P>,
