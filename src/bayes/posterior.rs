@@ -125,11 +125,13 @@ impl RecordTerm {
         } else {
             self.forward.simulate(theta, &mut solve.outputs)
         };
-        // A solve that gave up after its step cap did that work too (six right-hand sides a
-        // step); the other failures end early and are not counted.
+        // A solve that gave up after its step cap did that work too; the other failures end
+        // early and are not counted.
         self.solves.0.rhs_evaluations += match &result {
             Ok(stats) => stats.rhs_evaluations as u64,
-            Err(crate::ode::OdeError::TooManySteps { max_steps, .. }) => 6 * *max_steps as u64,
+            Err(crate::ode::OdeError::TooManySteps { max_steps, .. }) => {
+                (crate::ode::RHS_PER_STEP * max_steps) as u64
+            }
             Err(_) => 0,
         };
         result.map_err(|e| DensityError::recoverable(format!("{}: {e}", self.label)))?;

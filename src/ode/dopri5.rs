@@ -42,6 +42,10 @@ const D5: f64 = 701980252875.0 / 199316789632.0;
 const D6: f64 = -1453857185.0 / 822651844.0;
 const D7: f64 = 69997945.0 / 29380423.0;
 
+/// Right-hand sides a trial step evaluates: the seven stages less the first, which is the last
+/// step's seventh (first same as last).
+pub const RHS_PER_STEP: usize = 6;
+
 const SAFETY: f64 = 0.9;
 const MAX_GROWTH: f64 = 5.0; // per accepted step
 const MAX_SHRINK: f64 = 10.0;
@@ -165,7 +169,7 @@ where
                 return Err(OdeError::StepSizeUnderflow { t, h: h_step });
             }
             let err = try_step(system, t, segment, h_step, &y, &mut s, settings);
-            stats.rhs_evaluations += 6;
+            stats.rhs_evaluations += RHS_PER_STEP;
             if !err.is_finite() {
                 // A blown-up trial step: shrink hard and retry; a true blow-up ends in the step
                 // cap or the underflow check.

@@ -6,7 +6,7 @@
 mod dopri5;
 mod sampled;
 
-pub use dopri5::solve;
+pub use dopri5::{RHS_PER_STEP, solve};
 pub use sampled::{HeldInputSystem, solve_sampled};
 
 use serde::{Deserialize, Serialize};
