@@ -118,9 +118,12 @@ pub(super) fn laplace_is<P: Fittable>(
         first_khat.get_or_insert(khat);
         map_cost = output.map;
         // The refused sample with the lower k̂ is what stands if the fallback stops at its
-        // budget (a k̂ that could not be fitted, NaN, is never the lower).
-        let lower = refused.as_ref().and_then(|r: &RunOutput| r.khat);
-        if refused.is_none() || (khat.is_finite() && !lower.is_some_and(|lower| lower <= khat)) {
+        // budget (a k̂ that could not be fitted, NaN, ranks last).
+        let rank = |k: Option<f64>| k.filter(|k| !k.is_nan()).unwrap_or(f64::INFINITY);
+        if refused
+            .as_ref()
+            .is_none_or(|r: &RunOutput| rank(output.khat) < rank(r.khat))
+        {
             refused = Some(output);
         }
     }
