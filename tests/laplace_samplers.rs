@@ -29,12 +29,17 @@ fn settings(fallback: bool) -> RunSettings {
     }
 }
 
-#[test]
-fn a_banana_is_flagged_and_falls_back_to_nuts_unless_told_not_to() {
-    let mut banana = Banana {
+/// A banana bent far enough that the Laplace approximation's weights are heavy-tailed.
+fn bent_banana() -> Banana {
+    Banana {
         bend: 3.0,
         width: 0.2,
-    };
+    }
+}
+
+#[test]
+fn a_banana_is_flagged_and_falls_back_to_nuts_unless_told_not_to() {
+    let mut banana = bent_banana();
     let kept = run_sampler(&mut banana, &settings(false), "banana").unwrap();
     let khat = kept.khat.unwrap();
     assert!(khat > 0.7, "k̂ = {khat}");
@@ -56,10 +61,7 @@ fn a_banana_is_flagged_and_falls_back_to_nuts_unless_told_not_to() {
 
 #[test]
 fn a_fallback_past_its_gradient_budget_stops_and_the_refused_sample_stands() {
-    let mut banana = Banana {
-        bend: 3.0,
-        width: 0.2,
-    };
+    let mut banana = bent_banana();
     let kept = run_sampler(&mut banana, &settings(false), "banana").unwrap();
     // One gradient per transition on average: no NUTS transition spends less, so the budget
     // is spent before the last, and what stands is the sample k̂ refused, as it was drawn.
@@ -96,10 +98,7 @@ fn independence(fallback: bool, draws: usize) -> RunSettings {
 /// flags it (0.996 when written), and the run falls back before any chain draws.
 #[test]
 fn independence_on_a_banana_is_flagged_after_warm_up_and_falls_back_to_nuts() {
-    let mut banana = Banana {
-        bend: 3.0,
-        width: 0.2,
-    };
+    let mut banana = bent_banana();
     let kept = run_sampler(&mut banana, &independence(false, 4000), "banana").unwrap();
     let khat = kept.khat.unwrap();
     assert!(khat > 0.7, "k̂ = {khat}");
