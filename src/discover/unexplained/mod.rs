@@ -43,6 +43,7 @@ mod starts;
 mod state;
 mod step_screen;
 mod timing;
+mod torque_response;
 
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
@@ -65,6 +66,7 @@ use spans::spans;
 pub use starts::{DYNAMIC, dynamic_starts};
 pub use step_screen::StepScreen;
 use timing::FinePrediction;
+use torque_response::TorqueResponse;
 
 /// Input steps (besides the record's start) a ringing oscillation is fitted after at most: the
 /// largest ones; a long real record's many small steps ring too little to matter.
@@ -106,6 +108,9 @@ pub struct Context {
     /// Where the model holds a sensor lag: its channel (index in `channels`), its τ and the
     /// fine prediction with the lag switched off (τ = 0), what a resonant sensor replaces it on.
     pub lagged: Option<(usize, f64, FinePrediction)>,
+    /// What a torque added to the balances does to I and ω on the fine grid (the order search's
+    /// columns); none on a drive base.
+    pub torque: Option<TorqueResponse>,
     pub ln_n: f64,
 }
 
@@ -155,6 +160,7 @@ impl Context {
             sigma.push(s);
         }
         let fine = FinePrediction::of(&forward, &theta, &names)?;
+        let torque = TorqueResponse::of(&forward, &theta, fine.times[1] - fine.times[0]);
         let lagged = resonance::unlagged(&forward, &theta, &names)?;
         let projector = Projector::new(j);
         let y_perp = DVector::from_column_slice(
@@ -185,6 +191,7 @@ impl Context {
             steps,
             fine,
             lagged,
+            torque,
             ln_n: (problem.n_observations() as f64).ln(),
         })
     }

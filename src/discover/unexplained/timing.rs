@@ -59,22 +59,24 @@ impl FinePrediction {
     /// The integral of channel c from t = 0 (the trapezoid rule on the fine grid) at each of
     /// `times`: the angle θ = ∫ω dt of the predicted speed.
     pub(super) fn integral_at(&self, c: usize, times: &[f64]) -> Vec<f64> {
+        let sum = self.integral(c);
+        times.iter().map(|&t| self.read(&sum, t)).collect()
+    }
+
+    /// Channel c's integral from t = 0 on the fine grid (trapezoids).
+    pub(super) fn integral(&self, c: usize) -> Vec<f64> {
         let y = &self.channels[c];
         let h = self.times[1] - self.times[0];
         let mut sum = vec![0.0; y.len()];
         for k in 1..y.len() {
             sum[k] = sum[k - 1] + 0.5 * h * (y[k - 1] + y[k]);
         }
-        times.iter().map(|&t| self.read(&sum, t)).collect()
+        sum
     }
 
     /// `y`, a series on the fine grid, at time t (linear between grid points).
     fn read(&self, y: &[f64], t: f64) -> f64 {
-        let h = self.times[1] - self.times[0];
-        let u = (t / h).clamp(0.0, (y.len() - 1) as f64);
-        let k = (u.floor() as usize).min(y.len() - 2);
-        let w = u - k as f64;
-        y[k] * (1.0 - w) + y[k + 1] * w
+        read_on_grid(y, self.times[1] - self.times[0], t)
     }
 
     /// Channel c through τ·ẋ = u − x, x(0) = u(0), on the fine grid.
@@ -178,6 +180,14 @@ pub fn fit(
         sd,
         gain: best,
     })
+}
+
+/// `y`, a series on a grid of step `h` from t = 0, at time t (linear between grid points).
+pub(super) fn read_on_grid(y: &[f64], h: f64, t: f64) -> f64 {
+    let u = (t / h).clamp(0.0, (y.len() - 1) as f64);
+    let k = (u.floor() as usize).min(y.len() - 2);
+    let w = u - k as f64;
+    y[k] * (1.0 - w) + y[k + 1] * w
 }
 
 #[cfg(test)]
