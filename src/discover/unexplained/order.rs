@@ -240,6 +240,12 @@ mod tests {
         // The price is ln of the grid's points: four per 1/R over [2/R, 12].
         let points = ((12.0 - 2.0 / r) * 4.0 * r).floor() + 1.0;
         assert!((found.price - points.ln()).abs() < 0.01, "{}", found.price);
+        // Pure noise has its best order somewhere, but no gain near the ripple's.
+        let white = ripple_in_noise(&steady, 3.39, 0.7, 0.0, 8);
+        let chance = search_over(r, 12.0, |k| gain(&white, &steady.images(k))).unwrap();
+        let ripple = gain(&y, &steady.images(found.k));
+        let noise = gain(&white, &steady.images(chance.k));
+        assert!(ripple > 2.0 * noise, "{ripple} vs {noise}");
         // Too few revolutions, or nothing sampled above two periods over the record: no search.
         let slow = record(&response, &times, |_| 10.0);
         assert_eq!(search_over(slow.revolutions(), 12.0, |_| 1.0), None);
