@@ -160,7 +160,7 @@ impl Context {
             sigma.push(s);
         }
         let fine = FinePrediction::of(&forward, &theta, &names)?;
-        let torque = TorqueResponse::of(&forward, &theta, fine.times[1] - fine.times[0]);
+        let torque = TorqueResponse::of(&forward, &theta, fine.step());
         let lagged = resonance::unlagged(&forward, &theta, &names)?;
         let projector = Projector::new(j);
         let y_perp = DVector::from_column_slice(
@@ -244,7 +244,7 @@ impl Context {
     /// dŷ/dt of channel c (central differences on the fine grid), whitened.
     fn derivative(&self, c: usize) -> Vec<f64> {
         let y = &self.fine.channels[c];
-        let h = self.fine.times[1] - self.fine.times[0];
+        let h = self.fine.step();
         self.times
             .iter()
             .map(|&t| {

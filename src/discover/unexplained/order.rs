@@ -63,7 +63,7 @@ pub(super) fn search(ctx: &Context, k_max: f64) -> Option<Order> {
     let record = Record {
         response,
         angle: ctx.fine.integral(speed),
-        step: ctx.fine.times[1] - ctx.fine.times[0],
+        step: ctx.fine.step(),
         times: &ctx.times,
         read: ctx.channels.iter().map(|c| read_of(c)).collect(),
         sigma: &ctx.sigma,

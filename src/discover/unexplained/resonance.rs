@@ -43,7 +43,7 @@ pub struct Resonance {
 /// Channel `c` of the fine prediction through the filter, from rest at its first value.
 fn filtered(fine: &FinePrediction, c: usize, omega_n: f64, zeta: f64) -> Vec<f64> {
     let u = &fine.channels[c];
-    let h = fine.times[1] - fine.times[0];
+    let h = fine.step();
     // Sub-steps keep ω_n·h within classical Runge–Kutta's accurate range.
     let sub = ((omega_n * h / 0.3).ceil() as usize).max(1);
     let dt = h / sub as f64;

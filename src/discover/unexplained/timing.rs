@@ -63,10 +63,15 @@ impl FinePrediction {
         times.iter().map(|&t| self.read(&sum, t)).collect()
     }
 
+    /// The fine grid's step [s].
+    pub(super) fn step(&self) -> f64 {
+        self.times[1] - self.times[0]
+    }
+
     /// Channel c's integral from t = 0 on the fine grid (trapezoids).
     pub(super) fn integral(&self, c: usize) -> Vec<f64> {
         let y = &self.channels[c];
-        let h = self.times[1] - self.times[0];
+        let h = self.step();
         let mut sum = vec![0.0; y.len()];
         for k in 1..y.len() {
             sum[k] = sum[k - 1] + 0.5 * h * (y[k - 1] + y[k]);
@@ -76,13 +81,13 @@ impl FinePrediction {
 
     /// `y`, a series on the fine grid, at time t (linear between grid points).
     fn read(&self, y: &[f64], t: f64) -> f64 {
-        read_on_grid(y, self.times[1] - self.times[0], t)
+        read_on_grid(y, self.step(), t)
     }
 
     /// Channel c through τ·ẋ = u − x, x(0) = u(0), on the fine grid.
     fn filtered(&self, c: usize, tau: f64) -> Vec<f64> {
         let u = &self.channels[c];
-        let h = self.times[1] - self.times[0];
+        let h = self.step();
         let a = (-h / tau).exp();
         let beta = tau / h * (1.0 - a);
         let mut x = vec![u[0]; u.len()];
