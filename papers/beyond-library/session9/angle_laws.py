@@ -10,7 +10,7 @@ reports as RUN/CASE.json. A law is counted right when it is in the torque balanc
 sin(k*theta) and cos(k*theta) (no I·, no other function), and its k is within 1/R of the
 truth's, R the revolutions the record spans (the angle's Fourier spacing, the order search's
 cell), read from the report's fit as the integral of the recorded speed. Prints one row per
-case and run, then the count per run."""
+case and run, then the count per run, in all and per effect."""
 import csv, json, os, re, sys
 
 sets, runs = sys.argv[1].split(","), sys.argv[2].split(",")
@@ -26,6 +26,7 @@ def revolutions(case):
     return (hi - lo) / (2 * 3.141592653589793)
 
 right = {run: 0 for run in runs}
+by_effect = {}
 total = 0
 print("| case | true k | 1/R | " + " | ".join(f"law ({os.path.basename(r.rstrip('/'))})" for r in runs) + " |")
 print("|---|---|---|" + "---|" * len(runs))
@@ -38,6 +39,9 @@ for s in sets:
             continue
         cell = 1.0 / revolutions(case)
         total += 1
+        effect = answer["effect"]
+        counts = by_effect.setdefault(effect, [0, {run: 0 for run in runs}])
+        counts[0] += 1
         cells = []
         for run in runs:
             path = os.path.join(run, name + ".json")
@@ -52,9 +56,12 @@ for s in sets:
             ok = (d["balance"] == "torque" and names <= {"sin(k*theta)", "cos(k*theta)"}
                   and d.get("k") is not None and abs(d["k"] - k_true) <= cell)
             right[run] += ok
+            counts[1][run] += ok
             law = d["equation"].split(" [")[0].replace("|", "\\|")
             cells.append(("**right** " if ok else "") + law)
         print(f"| {name} | {k_true:.4g} | {cell:.3g} | " + " | ".join(cells) + " |")
 print()
 for run in runs:
     print(f"{run}: right {right[run]}/{total}")
+    for effect, (n, r) in sorted(by_effect.items()):
+        print(f"  {effect}: {r[run]}/{n}")
