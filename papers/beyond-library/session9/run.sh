@@ -33,3 +33,7 @@ python3 $HERE/angle_laws.py /tmp/sets/g72,/tmp/sets/g73,/tmp/hold/h74,/tmp/hold/
     /tmp/s9/OLD,/tmp/s9/NEW
 # The rise of a ripple law at chosen orders, through the ODE.
 MOTORCAL=$BIN_NEW $HERE/fits_by_order.sh /tmp/sets/g72/gear_ripple-720004 0.5335 0.467 0.371 0.057
+MOTORCAL=$BIN_NEW $HERE/fits_by_order.sh /tmp/hold/h74/gear_ripple-740027 0.5512 0.558 0.101
+MOTORCAL=$BIN_NEW $HERE/fits_by_order.sh /tmp/hold/h76/gear_ripple-760001 0.7623 0.726
+MOTORCAL=$BIN_NEW $HERE/fits_by_order.sh /tmp/hold/h77/gear_ripple-770017 0.2149 0.220
+MOTORCAL=$BIN_NEW $HERE/fits_by_order.sh /tmp/hold/h77/cogging-770008 12 10.56
