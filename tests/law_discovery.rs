@@ -141,8 +141,8 @@ fn a_cogging_torque_on_a_slow_record_is_discovered_at_its_slot_count() {
 /// line up with another stretch of the record. On cogging-770016 (`--effects
 /// gear_ripple,bearing_defect,eccentric,cogging --per-effect 5 --seed-base 770000 --volts 2`:
 /// six slots, a 2-σ ripple at 2 V) the fingerprint's regression started the fit in a valley 25
-/// nats below the truth's, where the law's coefficients were (−0.030, 0.109) against the
-/// truth's (0.155, −0.027), a state fingerprint was left over, and the sampled fit's
+/// nats below the truth's (papers/beyond-library/session10/phase_scan.sh prints both modes),
+/// its intervals missed the truth's coefficients, a state fingerprint was left over, and the sampled fit's
 /// importance weights sent it to NUTS (91 s of a diagnosis, papers/beyond-library.md, session
 /// 10). Started from the best of the phases and amplitudes tried about the fingerprint's, the
 /// law at the slot count holds both of the truth's coefficients, −a·cos φ and −a·sin φ, in its
