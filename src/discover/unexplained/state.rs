@@ -288,12 +288,17 @@ pub(super) fn fingerprints(
                 .map(Harmonic::on_grid)
                 .collect();
             // The order between the grid's the residual peaks at, where no grid point holds
-            // it: more than one of the angle's Fourier spacings from every one of them. Up to
-            // what the record samples and the grid's top (above it the inertia averages).
+            // it: more than a quarter of the angle's Fourier spacing (1/R) from every one of
+            // them. A whole order δk away keeps sinc²(π·δk·R) of the ripple's power, 81% at a
+            // quarter of 1/R, where the law's shape search (`width`) takes over; within a whole
+            // spacing it was lost: on bearing_defect-770014 (k 2.967, R 6.2) the search's 2.899
+            // was dropped for k = 3, whose column the regression passed over for I·sin θ, and
+            // σ_ω stayed 12% above the noise (papers/beyond-library.md, session 10). Up to what
+            // the record samples and the grid's top (above it the inertia averages).
             let top = HARMONICS[HARMONICS.len() - 1];
             let k_max = (std::f64::consts::PI / (speed * interval)).min(top);
             if let Some(o) = super::order::search(ctx, k_max)
-                && grid.iter().all(|h| (o.k - h.k).abs() > o.cell)
+                && grid.iter().all(|h| (o.k - h.k).abs() > o.cell / 4.0)
             {
                 grid.push(Harmonic {
                     k: o.k,
