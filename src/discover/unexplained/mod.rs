@@ -64,6 +64,7 @@ use regression::{Explained, Projector, explain};
 pub use spans::Span;
 use spans::spans;
 pub use starts::{DYNAMIC, dynamic_starts};
+pub use state::whole_order;
 pub use step_screen::StepScreen;
 use timing::FinePrediction;
 use torque_response::TorqueResponse;

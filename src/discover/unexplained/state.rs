@@ -144,6 +144,21 @@ pub(super) struct Harmonic {
     pub width: f64,
 }
 
+/// The half-width of the search through the ODE around an order the order search found, as a
+/// share of the angle's Fourier spacing 1/R: the peak places k within a quarter of it.
+const SEARCH_WIDTH: f64 = 0.25;
+
+/// The grid's order nearest a searched `k` fitted with half-width `width`, where it lies within
+/// one of the angle's Fourier spacings (`width / SEARCH_WIDTH`): the whole order the ripple
+/// may be at, its peak pulled aside by the ripple's own push on the angle (see `fingerprints`).
+pub fn whole_order(k: f64, width: f64) -> Option<f64> {
+    let cell = width / SEARCH_WIDTH;
+    HARMONICS
+        .into_iter()
+        .min_by(|a, b| (a - k).abs().total_cmp(&(b - k).abs()))
+        .filter(|w| (w - k).abs() <= cell)
+}
+
 impl Harmonic {
     fn on_grid(k: f64) -> Self {
         Self {
@@ -293,17 +308,22 @@ pub(super) fn fingerprints(
             // quarter of 1/R, where the law's shape search (`width`) takes over; within a whole
             // spacing it was lost: on bearing_defect-770014 (k 2.967, R 6.2) the search's 2.899
             // was dropped for k = 3, whose column the regression passed over for I·sin θ, and
-            // σ_ω stayed 12% above the noise (papers/beyond-library.md, session 10). Up to what
-            // the record samples and the grid's top (above it the inertia averages).
+            // σ_ω stayed 12% above the noise (papers/beyond-library.md, session 10). Within a
+            // spacing of a whole order, the law is also fitted at that order (`whole_order`):
+            // a strong cogging's peak lies off its slot count as its own ripple moves the
+            // angle, and the fits decide. Up to what the record samples and the grid's top
+            // (above it the inertia averages).
             let top = HARMONICS[HARMONICS.len() - 1];
             let k_max = (std::f64::consts::PI / (speed * interval)).min(top);
             if let Some(o) = super::order::search(ctx, k_max)
-                && grid.iter().all(|h| (o.k - h.k).abs() > o.cell / 4.0)
+                && grid
+                    .iter()
+                    .all(|h| (o.k - h.k).abs() > SEARCH_WIDTH * o.cell)
             {
                 grid.push(Harmonic {
                     k: o.k,
                     price: o.price,
-                    width: o.cell / 4.0,
+                    width: SEARCH_WIDTH * o.cell,
                 });
             }
             grid
