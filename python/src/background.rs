@@ -19,8 +19,9 @@ const SIGNAL_CHECK: Duration = Duration::from_millis(50);
 const PROGRESS_EVERY: Duration = Duration::from_millis(250);
 
 /// A run's progress as the calling thread shows it: the transitions counted so far out of
-/// `total`, drawn by `motorcal._progress(label, done, total)` (one line, rewritten in place,
-/// which a terminal and a notebook's output cell both show as one bar).
+/// `total`, drawn by `motorcal._progress(label, done, total, finished)` (one line, rewritten in
+/// place, which a terminal and a notebook's output cell both show as one bar; ended once the
+/// work has returned).
 pub struct Progress {
     pub label: String,
     pub done: Arc<AtomicUsize>,
@@ -38,6 +39,7 @@ impl Progress {
             self.label.as_str(),
             done,
             self.total,
+            finished,
         ))?;
         Ok(())
     }

@@ -139,6 +139,15 @@ def test_the_posterior_predictive_scatters_about_the_fit_by_its_noise(py_fit):
         assert 0.9 * sigma < spread < 1.2 * sigma, (name, spread, sigma)
 
 
+def test_a_redraw_at_the_total_does_not_end_the_line_before_the_run_returns(capfd):
+    # On a loaded machine the count reached its total a redraw before the run returned, and
+    # the line was ended twice (a clean-clone CI, 2026-11-29).
+    motorcal._progress("fit", 800, 800, False)
+    motorcal._progress("fit", 800, 800, True)
+    err = capfd.readouterr().err
+    assert err.count("\n") == 1 and err.endswith("\n")
+
+
 def test_progress_is_one_line_redrawn_and_ended_at_the_total(recording, model, capfd):
     motorcal.fit(recording, model, bm=1, chains=2, draws=300, seed=5, progress=True)
     err = capfd.readouterr().err

@@ -193,12 +193,15 @@ def fit(
     return result
 
 
-def _progress(label, done, total):
-    """One line of progress on standard error, rewritten in place; ended when done."""
+def _progress(label, done, total, finished):
+    """One line of progress on standard error, rewritten in place; ended once the run has
+    returned (`finished`), not when the count first reaches the total: the run still writes
+    its draws and predictions after its last transition, and a redraw then must not end the
+    line a second time."""
     width = 30
     filled = width * done // max(total, 1)
     bar = "#" * filled + "-" * (width - filled)
-    end = "\n" if done >= total else ""
+    end = "\n" if finished else ""
     sys.stderr.write(f"\r{label} [{bar}] {done}/{total} transitions{end}")
     sys.stderr.flush()
 
