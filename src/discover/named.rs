@@ -159,37 +159,34 @@ fn phase_twin(fingerprint: &Fingerprint) -> Option<Fingerprint> {
     Some(twin)
 }
 
-/// The balance of what is read of `channel` (a pickup on its sensor's cable: mains hum on a
-/// current reading runs on whatever the motor does, as a supply's ripple does, and differs
-/// from it only by what the ripple would drive through the motor into the other channel).
 /// `fingerprint` at the grid's whole order nearest the k the order search found, where one lies
 /// within the angle's Fourier spacing (`unexplained::whole_order`), with both halves of the
 /// ripple's pair, the k neither searched nor paid for. A strong ripple moves the angle it
 /// depends on, so its residual's peak can lie off a whole order the truth is at: on
-/// cogging-770016 (six slots) the first-order regression took sin(6.057·θ) at 50.0 nats over
-/// the pair at k = 6 at 36.8, where through the ODE the law at 6 scores higher than the
-/// searched one refined to 6.012 (`motorcal diagnose` on the fixture, before and after). The
-/// fits decide, the searched k paying its grid.
+/// cogging-770016 (six slots) the first-order regression took sin(6.057·θ) at 49.97 nats over
+/// the pair at k = 6 at 36.80, where through the ODE the law at 6 scores higher than the
+/// searched one refined to 6.012 (`papers/beyond-library/session11/fixtures.sh`, its output
+/// beside it). The fits decide, the searched k paying its grid.
 fn whole_order_twin(fingerprint: &Fingerprint) -> Option<Fingerprint> {
     let mut twin = phase_twin(fingerprint).unwrap_or_else(|| fingerprint.clone());
-    let Fingerprint::State {
+    if let Fingerprint::State {
         harmonic: Some(k),
         harmonic_price,
         harmonic_width,
         ..
     } = &mut twin
-    else {
-        return None;
-    };
-    if *harmonic_width <= 0.0 {
-        return None;
+        && *harmonic_width > 0.0
+    {
+        *k = whole_order(*k, *harmonic_width)?;
+        (*harmonic_price, *harmonic_width) = (0.0, 0.0);
+        return Some(twin);
     }
-    *k = whole_order(*k, *harmonic_width)?;
-    *harmonic_price = 0.0;
-    *harmonic_width = 0.0;
-    Some(twin)
+    None
 }
 
+/// The balance of what is read of `channel` (a pickup on its sensor's cable: mains hum on a
+/// current reading runs on whatever the motor does, as a supply's ripple does, and differs
+/// from it only by what the ripple would drive through the motor into the other channel).
 fn reading_of(channel: &str) -> Option<usize> {
     let balance = format!("measurement:{channel}");
     BALANCES.iter().position(|b| *b == balance)
