@@ -77,7 +77,7 @@ pub fn named_terms(problem: &Problem, fingerprint: &Fingerprint) -> Vec<NamedTer
             .chain(ripple_twin(fingerprint))
             .flat_map(|f| {
                 let pair = phase_twin(&f);
-                let order = whole_order_twin(&f);
+                let order = whole_order_twin(pair.as_ref().unwrap_or(&f));
                 std::iter::once(f).chain(pair).chain(order)
             })
             .filter_map(|f| named_term(problem, &f))
@@ -159,16 +159,17 @@ fn phase_twin(fingerprint: &Fingerprint) -> Option<Fingerprint> {
     Some(twin)
 }
 
-/// `fingerprint` at the grid's whole order nearest the k the order search found, where one lies
-/// within the angle's Fourier spacing (`unexplained::whole_order`), with both halves of the
-/// ripple's pair, the k neither searched nor paid for. A strong ripple moves the angle it
-/// depends on, so its residual's peak can lie off a whole order the truth is at: on
+/// `fingerprint` (given with both halves of the ripple's pair: its `phase_twin` where it has
+/// one) at the grid's whole order nearest the k the order search found, where one lies within
+/// the angle's Fourier spacing (`unexplained::whole_order`), the k neither searched nor paid
+/// for. A strong ripple moves the angle it depends on, so its residual's peak can lie off a
+/// whole order the truth is at: on
 /// cogging-770016 (six slots) the first-order regression took sin(6.057·θ) at 49.97 nats over
 /// the pair at k = 6 at 36.80, where through the ODE the law at 6 scores higher than the
 /// searched one refined to 6.012 (`papers/beyond-library/session11/fixtures.sh`, its output
 /// beside it). The fits decide, the searched k paying its grid.
 fn whole_order_twin(fingerprint: &Fingerprint) -> Option<Fingerprint> {
-    let mut twin = phase_twin(fingerprint).unwrap_or_else(|| fingerprint.clone());
+    let mut twin = fingerprint.clone();
     if let Fingerprint::State {
         harmonic: Some(k),
         harmonic_price,
