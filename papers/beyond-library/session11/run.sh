@@ -1,7 +1,8 @@
 #!/bin/sh
 # Session 11's runs, as they were made (the runs are named phase and whole). BIN_phase is a build of 595d721 (session 10's kept
 # science), BIN_whole of 863f82b (the order's peak a quarter spacing from a whole order, and the
-# law also fitted at that whole order); STUDY the example diagnose_study of 863f82b. The cases
+# law also fitted at that whole order), BIN_QUARTER of 78271af (session 10's reverted quarter rule);
+# STUDY the example diagnose_study of 863f82b. The cases
 # are session 9's, remade by its run.sh (beyond_library_cases, seeds 760000 and 770000 --volts 2)
 # into /tmp/hold/h76 and h77.
 set -e
