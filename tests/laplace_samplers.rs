@@ -6,12 +6,16 @@
 use motorcal::bayes::{CalibrationPosterior, ModelSettings};
 use motorcal::io::ModelFile;
 use motorcal::motor::{MotorModel, MotorParameters, VoltageInput};
-use motorcal::pipeline::{MetricAdaptation, RunSettings, SamplerKind, default_warmup, run_sampler};
+use motorcal::pipeline::{
+    LAPLACE_WARMUP, MetricAdaptation, RunSettings, SamplerKind, default_warmup, run_sampler,
+};
 use motorcal::sampler::ChainSettings;
 use motorcal::sampler::targets::{Banana, StudentT};
 use motorcal::study::cases::{DURATION, NOISE_SD, SAMPLES};
 use motorcal::study::{Problem, recording_from};
 use motorcal::synthetic::{generate, sample_times};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 fn settings(fallback: bool) -> RunSettings {
     RunSettings {
@@ -57,6 +61,69 @@ fn a_banana_is_flagged_and_falls_back_to_nuts_unless_told_not_to() {
     // (−5.8 MCSE) — the far ends of the arms are missed. The claim here is the flag and the
     // fallback.
     assert!(run.max_rhat.is_finite() && run.min_ess_bulk > 0.0);
+}
+
+/// `run_sampler` with a count of its chains' transitions (NUTS's; importance sampling draws
+/// proposals, not transitions): what the fallback's warm-ups were.
+fn counted(
+    target: &mut impl motorcal::pipeline::Fittable,
+    settings: RunSettings,
+) -> (motorcal::pipeline::RunOutput, usize) {
+    let count = Arc::new(AtomicUsize::new(0));
+    let settings = RunSettings {
+        transitions: Some(count.clone()),
+        ..settings
+    };
+    let run = run_sampler(target, &settings, "counted").unwrap();
+    (run, count.load(Ordering::Relaxed))
+}
+
+/// Above 0.7, k̂ cannot tell a banana's arms from a Gaussian shape that the Laplace
+/// approximation gets only a little wrong: a Student-t with 6 degrees of freedom in three
+/// dimensions, whose tails thin the first proposal's weights past use (k̂ > 0.7) but whose
+/// shape a dense metric from the Hessian fits. NUTS on that metric, with its short warm-up,
+/// passes its own diagnostics there, and is kept: one run of 4 × (100 + 1000) transitions, no
+/// run in Stan's windows after it.
+#[test]
+fn above_the_line_nuts_keeps_the_laplace_metric_where_its_own_run_converges() {
+    let mut target = StudentT { df: 6.0, dim: 3 };
+    let (run, transitions) = counted(&mut target, is_settings(true, 1000));
+    let khat = run.khat.unwrap();
+    eprintln!(
+        "k̂ {khat:.3}; R-hat {:.4}, min bulk ESS {:.0}, {} divergences, {transitions} transitions",
+        run.max_rhat, run.min_ess_bulk, run.divergences
+    );
+    assert!(khat > 0.7, "k̂ = {khat}");
+    assert!(run.fell_back);
+    assert_eq!(run.sampler, "nuts-dense");
+    assert_eq!(transitions, 4 * (LAPLACE_WARMUP + 1000));
+    assert!(run.max_rhat <= 1.01 && run.min_ess_bulk >= 400.0 && run.divergences == 0);
+    for i in 1..=3 {
+        let s = run.summary(&format!("x.{i}")).unwrap();
+        assert!(s.mean.abs() < 0.1, "x.{i}: mean {}", s.mean);
+    }
+}
+
+/// Where the Laplace metric's run fails its own diagnostics — the bent banana, whose arms no
+/// single metric fits — Stan's windows re-estimate the metric in a second run, which is the one
+/// kept: 4 × (100 + 4000) transitions on the Laplace metric, then 4 × (1000 + 4000).
+#[test]
+fn where_the_laplace_metric_fails_its_own_diagnostics_stan_s_windows_run_after_it() {
+    let mut banana = bent_banana();
+    let (run, transitions) = counted(&mut banana, settings(true));
+    eprintln!(
+        "k̂ {:.3}; R-hat {:.4}, min bulk ESS {:.0}, {} divergences, {transitions} transitions",
+        run.khat.unwrap(),
+        run.max_rhat,
+        run.min_ess_bulk,
+        run.divergences
+    );
+    assert!(run.fell_back);
+    assert_eq!(
+        transitions,
+        4 * (LAPLACE_WARMUP + 4000)
+            + 4 * (default_warmup(SamplerKind::NutsDense, MetricAdaptation::Windows) + 4000)
+    );
 }
 
 #[test]
@@ -232,8 +299,9 @@ fn a_wider_proposal_tried_before_nuts_covers_tails_heavier_than_the_first_s_and_
 /// all four: a chain sticks where the weights' variance is infinite, k > ½, which is the
 /// independence sampler's bound (`pipeline::independence`). Flagged and handed to NUTS on all
 /// four: on the Laplace metric with a step-size warm-up where k̂ ≤ 0.7 (the approximation was
-/// refused for weighing, not as a shape), re-estimating the metric in Stan's windows above —
-/// a warm-up of under half the draws' gradients against one longer than theirs.
+/// refused for weighing, not as a shape), and above it too where that run passes its own
+/// diagnostics; else re-estimating the metric in Stan's windows — a warm-up of under half the
+/// draws' gradients against one longer than theirs.
 #[test]
 fn independence_on_a_friction_term_at_its_bound_is_flagged_and_falls_back() {
     for noise_seed in 1..=4 {
@@ -260,11 +328,15 @@ fn independence_on_a_friction_term_at_its_bound_is_flagged_and_falls_back() {
         );
         let warmup = run.warmup.gradient_evaluations as f64;
         let draws = run.sampling.gradient_evaluations as f64;
+        // Kept on the Laplace metric (a short warm-up) wherever k̂ ≤ 0.7; above, only where
+        // that run passed its own diagnostics, no divergence among them.
         if khat <= 0.7 {
             assert!(
                 warmup < 0.5 * draws,
                 "seed {noise_seed}: {warmup} vs {draws}"
             );
+        } else if warmup < 0.5 * draws {
+            assert_eq!(run.divergences, 0, "seed {noise_seed}");
         } else {
             assert!(warmup > draws, "seed {noise_seed}: {warmup} vs {draws}");
         }
