@@ -19,7 +19,7 @@ use super::candidate::{Candidate, Confirmation, answer_params};
 use super::coincide::InputCoincidence;
 use super::discovered::{Discovered, discovered};
 use super::fits::{self, Convergence, FitSummary, Mismatch, SampledFit};
-use super::named::fit_named_terms;
+use super::named::{Naming, fit_named_terms};
 use super::prune::prune_law;
 use super::screen::collinear_pairs;
 use super::selection::Selection;
@@ -229,27 +229,17 @@ pub fn assemble(
     if !selected_fit.added.is_empty() {
         bases.push(&none);
     }
-    let named_fit = match &left {
-        Some(verdict) => fit_named_terms(
-            problem,
-            std::iter::once(&verdict.fingerprint).chain(&verdict.considered),
-            &bases,
-            &selected_fit,
-            allowed,
-        )?,
-        None => None,
-    };
+    let mut naming: Vec<Naming> = Vec::new();
+    if let Some(verdict) = &left {
+        let fingerprints = std::iter::once(&verdict.fingerprint).chain(&verdict.considered);
+        naming.push((fingerprints.collect(), bases));
+    }
     // Where nothing was selected the verdict holds these laws already.
-    let proposed_fit = if selected_fit.added.is_empty() {
-        None
-    } else {
-        let laws = as_given.fingerprints();
-        fit_named_terms(problem, laws, &[&none], &selected_fit, allowed)?
-    };
-    let best = [named_fit, proposed_fit]
-        .into_iter()
-        .flatten()
-        .max_by(|a, b| a.score.total_cmp(&b.score));
+    if !selected_fit.added.is_empty() {
+        naming.push((as_given.fingerprints().collect(), vec![&none]));
+    }
+    // One call, so that a law both name is fitted once and all the fits share the cores.
+    let best = fit_named_terms(problem, naming, &selected_fit, allowed)?;
     if let Some(fit) = best {
         let before = selected_fit.score;
         found = discovered(&fit, fit.score - before);
@@ -260,14 +250,12 @@ pub fn assemble(
         // ripple's phase, which the first fit's start did not hold): one more round, which may
         // only extend the law, by the same threshold.
         let extended = match (&found, &left) {
-            (Some(_), Some(verdict)) => fit_named_terms(
-                problem,
-                std::iter::once(&verdict.fingerprint).chain(&verdict.considered),
-                &[&selected_fit],
-                &selected_fit,
-                allowed,
-            )?
-            .filter(|fit| fit.added == selected_fit.added),
+            (Some(_), Some(verdict)) => {
+                let fingerprints = std::iter::once(&verdict.fingerprint).chain(&verdict.considered);
+                let naming = [(fingerprints.collect(), vec![&selected_fit])];
+                fit_named_terms(problem, naming, &selected_fit, allowed)?
+                    .filter(|fit| fit.added == selected_fit.added)
+            }
             _ => None,
         };
         if let Some(fit) = extended {

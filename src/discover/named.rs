@@ -502,34 +502,48 @@ fn extended(held: &Law, more: &Law) -> Law {
     law
 }
 
+/// The fingerprints to name, and the fits to name each beside.
+pub type Naming<'a> = (Vec<&'a Fingerprint>, Vec<&'a Candidate>);
+
 /// The best fit of a term the fingerprints name (every kind that cleared the threshold on its
 /// own, not only the leader: the fits, not the linearised scores, decide), each fitted beside
-/// every one of `bases`, when it beats `selected` by more than the threshold. Where the user
-/// named the candidates (`allowed`), only those may be added: the list says what the diagnosis
-/// may add to the model, whichever way it finds them.
+/// every one of its group's bases, when it beats `selected` by more than the threshold. Where
+/// the user named the candidates (`allowed`), only those may be added: the list says what the
+/// diagnosis may add to the model, whichever way it finds them.
 pub fn fit_named_terms<'a>(
     problem: &Problem,
-    fingerprints: impl IntoIterator<Item = &'a Fingerprint>,
-    bases: &[&Candidate],
+    groups: impl IntoIterator<Item = Naming<'a>>,
     selected: &Candidate,
     allowed: Option<&[String]>,
 ) -> Result<Option<Candidate>, Error> {
-    let mut named: Vec<NamedTerm> = Vec::new();
-    for n in fingerprints
-        .into_iter()
-        .flat_map(|f| named_terms(problem, f))
-    {
-        if !named.iter().any(|m| m.same_term(&n))
-            && allowed.is_none_or(|a| a.iter().any(|c| c == n.term.name()))
+    let mut jobs: Vec<(&Candidate, NamedTerm)> = Vec::new();
+    for (fingerprints, bases) in groups {
+        let mut named: Vec<NamedTerm> = Vec::new();
+        for n in fingerprints
+            .into_iter()
+            .flat_map(|f| named_terms(problem, f))
         {
-            named.push(n);
+            if !named.iter().any(|m| m.same_term(&n))
+                && allowed.is_none_or(|a| a.iter().any(|c| c == n.term.name()))
+            {
+                named.push(n);
+            }
+        }
+        for n in named {
+            for &with in &bases {
+                // The same term from the same start beside the same fit is one fit, however
+                // many groups name it: the model as given's laws are often the verdict's after
+                // a library term that does not touch them (cogging-770012 fitted four laws,
+                // each with its harmonic searched, twice over).
+                if adds_nothing(with, &n)
+                    || jobs.iter().any(|(w, m)| std::ptr::eq(*w, with) && *m == n)
+                {
+                    continue;
+                }
+                jobs.push((with, n.clone()));
+            }
         }
     }
-    let jobs: Vec<(&Candidate, &NamedTerm)> = named
-        .iter()
-        .flat_map(|n| bases.iter().map(move |b| (*b, n)))
-        .filter(|(with, n)| !adds_nothing(with, n))
-        .collect();
     // A fit that fails (a stiff resonance far from the data) is no candidate, not an error of
     // the diagnosis.
     let fits: Vec<Candidate> = jobs
