@@ -123,20 +123,38 @@ fn a_profile_name_still_works_and_a_bad_file_writes_nothing() {
 }
 
 /// A drive base measures other channels than I and ω (HSM150's current-driven base measures ω
-/// alone): the noise line names the model's own, where it used to index a second channel.
+/// alone): the noise line names the model's own, where it used to index a second channel. Its
+/// input is the commanded current of a `t,I` file; a profile has no current to run at.
 #[test]
 fn a_drive_base_truth_is_simulated_and_its_channels_named() {
     let dir = scratch("drive-base");
+    let input = dir.join("current.csv");
+    std::fs::write(&input, "t,I\n0.001,1\n0.002,1\n0.003,-1\n").unwrap();
     let truth = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/hsm150/model.toml");
-    let o = motorcal(&["simulate", "--truth", truth, "--out", dir.to_str().unwrap()]);
+    let out = dir.join("sim");
+    let simulate = |input: &str| {
+        motorcal(&[
+            "simulate",
+            "--truth",
+            truth,
+            "--input",
+            input,
+            "--out",
+            out.to_str().unwrap(),
+        ])
+    };
+    let o = simulate(input.to_str().unwrap());
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{err}");
     assert!(!err.contains("panicked"), "{err}");
-    let out = String::from_utf8_lossy(&o.stdout);
-    let line = out
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    let line = stdout
         .lines()
         .find(|l| l.starts_with("realised noise sd:"))
         .expect("the noise line");
     assert!(line.contains("omega") && !line.contains(','), "{line}");
-    assert!(dir.join("recording.csv").exists());
+    assert!(out.join("recording.csv").exists());
+    std::fs::remove_dir_all(&out).unwrap();
+    one_error_line(&simulate("constant"), &["--input constant", "t,I"]);
+    assert!(!out.exists());
 }

@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use crate::io::{
-    ModelFile, read_model_file, read_voltage_profile, write_model_file, write_recording,
+    ModelFile, read_input_profile, read_model_file, write_model_file, write_recording,
 };
 use crate::motor::{MotorParameters, VoltageInput};
 pub use crate::study::InputProfile;
@@ -68,10 +68,12 @@ pub struct SimulateOptions {
     #[arg(long, default_value_t = DEFAULT_SEED)]
     pub seed: u64,
     /// The input: a profile (constant, step, reversal, square) or the path of a `t,U` file
-    /// (a designed or recorded input), whose times the recording then takes.
+    /// (a designed or recorded input; `t,I` for a current_driven truth, the commanded
+    /// current), whose times the recording then takes.
     #[arg(long, default_value = "constant", value_parser = InputSource::parse)]
     pub input: InputSource,
-    /// Noise standard deviations of I [A] and ω [rad/s].
+    /// Noise standard deviations of I [A] and ω [rad/s] (a current_driven truth measures ω
+    /// alone and takes SD_OMEGA).
     #[arg(long, num_args = 2, value_names = ["SD_I", "SD_OMEGA"], default_values_t = [2.0, 10.0])]
     pub noise_sd: Vec<f64>,
     /// Samples of the record (default 501; an input file's rows otherwise).
@@ -213,7 +215,19 @@ pub fn simulate(options: &SimulateOptions) -> Result<SimulateReport, AppError> {
             ..ModelFile::default()
         },
     };
-    let (times, input) = match &options.input {
+    if options.noise_sd.len() != 2
+        || options
+            .noise_sd
+            .iter()
+            .any(|s| !(*s >= 0.0 && s.is_finite()))
+    {
+        return Err(AppError::Usage(format!(
+            "--noise-sd {:?} : must be non-negative numbers",
+            options.noise_sd
+        )));
+    }
+    let noise_sd = [options.noise_sd[0], options.noise_sd[1]];
+    let (recording, data) = match &options.input {
         InputSource::File(path) => {
             if options.samples.is_some() || options.t_end.is_some() {
                 return Err(AppError::Usage(format!(
@@ -222,14 +236,33 @@ pub fn simulate(options: &SimulateOptions) -> Result<SimulateReport, AppError> {
                     path.display()
                 )));
             }
-            let profile = read_voltage_profile(path)?;
-            let input = VoltageInput::Held {
-                times: profile.times.clone(),
-                values: profile.values,
+            let truth_error = |e: crate::error::Error| match e {
+                crate::error::Error::Settings(s) => {
+                    AppError::Usage(format!("--truth: {}", s.message))
+                }
+                e => AppError::from(e),
             };
-            (profile.times, input)
+            let column = crate::study::input_column(truth_file.base).map_err(truth_error)?;
+            let profile = read_input_profile(path, column)?;
+            crate::study::held_input_record(
+                &truth_file,
+                &profile.times,
+                profile.values,
+                &noise_sd,
+                options.seed,
+                "motorcal simulate",
+            )
+            .map_err(truth_error)?
         }
         InputSource::Profile(profile) => {
+            if truth_file.base.is_drive() {
+                return Err(AppError::Usage(format!(
+                    "--input {}: a {} truth is driven by a recorded input; give the path of a \
+                     t,I file (the commanded current)",
+                    profile.name(),
+                    truth_file.base.name()
+                )));
+            }
             let samples = options.samples.unwrap_or(DEFAULT_SAMPLES);
             let t_end = options.t_end.unwrap_or(DEFAULT_T_END);
             if samples < 2 {
@@ -244,30 +277,19 @@ pub fn simulate(options: &SimulateOptions) -> Result<SimulateReport, AppError> {
             }
             let times = sample_times(t_end, samples);
             let input = profile.voltage(truth_file.motor.voltage, &times);
-            (times, input)
+            let model = truth_file
+                .model(input.clone())
+                .map_err(|e| AppError::Usage(format!("--truth: {e}")))?;
+            let data = generate(&model, &times, &noise_sd, options.seed)
+                .map_err(|e| AppError::Numerical(e.to_string()))?;
+            let voltage = match input {
+                VoltageInput::Held { values, .. } => Some(values),
+                VoltageInput::Constant => None,
+            };
+            let recording = crate::study::recording_from(&data, "motorcal simulate", voltage);
+            (recording, data)
         }
     };
-    if options.noise_sd.len() != 2
-        || options
-            .noise_sd
-            .iter()
-            .any(|s| !(*s >= 0.0 && s.is_finite()))
-    {
-        return Err(AppError::Usage(format!(
-            "--noise-sd {:?} : must be non-negative numbers",
-            options.noise_sd
-        )));
-    }
-    let model = truth_file
-        .model(input.clone())
-        .map_err(|e| AppError::Usage(format!("--truth: {e}")))?;
-    let data = generate(&model, &times, &options.noise_sd, options.seed)
-        .map_err(|e| AppError::Numerical(e.to_string()))?;
-    let voltage = match input {
-        VoltageInput::Held { values, .. } => Some(values),
-        VoltageInput::Constant => None,
-    };
-    let recording = crate::study::recording_from(&data, "motorcal simulate", voltage);
     let report = SimulateReport {
         recording: options.out.join("recording.csv"),
         nominal: options.out.join("motor.toml"),

@@ -1,5 +1,6 @@
 //! An input profile as a file: the `t,U` table that `motorcal design` writes and `simulate
-//! --input FILE` (or a test bench) takes; other columns are ignored.
+//! --input FILE` (or a test bench) takes — `t,I` for a current-driven model, whose input is the
+//! commanded current; other columns are ignored.
 
 use std::io;
 use std::path::Path;
@@ -8,7 +9,8 @@ use super::atomic::{with_path, write_atomically};
 use super::error::{InputError, read_text};
 use super::table::{self, Line};
 
-/// A voltage held between sample times: `values[i]` from `times[i]` on (and before `times[0]`).
+/// An input held between sample times: `values[i]` from `times[i]` on (and before `times[0]`).
+/// A voltage, or for a current-driven model the current.
 #[derive(Clone, Debug, PartialEq)]
 pub struct VoltageProfile {
     pub times: Vec<f64>,
@@ -18,6 +20,12 @@ pub struct VoltageProfile {
 /// Reads a `t,U` file: non-negative, strictly increasing times, finite voltages, at least two
 /// rows.
 pub fn read_voltage_profile(path: &Path) -> Result<VoltageProfile, InputError> {
+    read_input_profile(path, "U")
+}
+
+/// Reads a `t,<column>` file (`U`, or `I` for a current command) as [`read_voltage_profile`]
+/// reads a `t,U` one.
+pub fn read_input_profile(path: &Path, input: &str) -> Result<VoltageProfile, InputError> {
     let text = read_text(path, |text, line, column| {
         table::column_at(text, line, column)
     })?;
@@ -37,14 +45,15 @@ pub fn read_voltage_profile(path: &Path) -> Result<VoltageProfile, InputError> {
             .at_line(header_line)
             .for_field(wanted)),
             (None, _) => Err(err(format!(
-                "no column '{wanted}'; an input file has the columns t,U (the header has {})",
+                "no column '{wanted}'; this model's input file has the columns t,{input} (the \
+                 header has {})",
                 names.join(",")
             ))
             .at_line(header_line)
             .for_field(wanted)),
         }
     };
-    let (t_col, u_col) = (column("t")?, column("U")?);
+    let (t_col, u_col) = (column("t")?, column(input)?);
     let mut profile = VoltageProfile {
         times: Vec::new(),
         values: Vec::new(),
@@ -100,6 +109,11 @@ pub fn read_voltage_profile(path: &Path) -> Result<VoltageProfile, InputError> {
 
 /// Writes a profile as `t,U` with round-trip precision.
 pub fn write_voltage_profile(path: &Path, profile: &VoltageProfile) -> io::Result<()> {
+    write_input_profile(path, "U", profile)
+}
+
+/// Writes a profile as `t,<column>` (`U`, or `I` for a current command).
+pub fn write_input_profile(path: &Path, input: &str, profile: &VoltageProfile) -> io::Result<()> {
     if profile.times.len() != profile.values.len()
         || profile
             .times
@@ -115,7 +129,7 @@ pub fn write_voltage_profile(path: &Path, profile: &VoltageProfile) -> io::Resul
             ),
         ));
     }
-    let mut out = String::from("t,U\n");
+    let mut out = format!("t,{input}\n");
     for (t, u) in profile.times.iter().zip(&profile.values) {
         table::push_number(&mut out, *t);
         out.push(',');
@@ -146,6 +160,15 @@ mod tests {
         let path = scratch("round.csv", "");
         write_voltage_profile(&path, &profile).unwrap();
         assert_eq!(read_voltage_profile(&path).unwrap(), profile);
+        let current = scratch("current.csv", "");
+        write_input_profile(&current, "I", &profile).unwrap();
+        assert!(
+            std::fs::read_to_string(&current)
+                .unwrap()
+                .starts_with("t,I\n")
+        );
+        assert_eq!(read_input_profile(&current, "I").unwrap(), profile);
+        assert!(read_voltage_profile(&current).is_err());
     }
 
     #[test]

@@ -21,7 +21,10 @@ mod toml_lines;
 pub use atomic::{AtomicFile, write_atomically};
 pub use draws::{CmdStanWriter, DrawSet, SAMPLER_COLUMNS, SamplerColumns, read_draws};
 pub use error::InputError;
-pub use input_file::{VoltageProfile, read_voltage_profile, write_voltage_profile};
+pub use input_file::{
+    VoltageProfile, read_input_profile, read_voltage_profile, write_input_profile,
+    write_voltage_profile,
+};
 pub use model_file::{
     MODEL_FILE_SCHEMA, ModelFile, parse_model_file, read_model_file, to_toml_string,
     write_model_file,
