@@ -19,7 +19,8 @@ fn main() {
     let model =
         motorcal::io::read_model_file(std::path::Path::new(&format!("{dir}/motor.toml"))).unwrap();
     let times = design::design_times(0.5, 1000.0).unwrap();
-    let base = design::design_problem(&model, &times).unwrap();
+    let base = design::design_problem(&model, &times, &"U=±24,I=±300,omega=±3000".parse().unwrap())
+        .unwrap();
     let d: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&args[4]).unwrap()).unwrap();
     let vals = d["candidates_at"]["values"].as_object().unwrap();

@@ -141,7 +141,7 @@ fn separate(
     let diag: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("diag.json"))?)?;
     let times = design_times(0.5, 1000.0)?;
-    let base = design_problem(&model, &times)?;
+    let base = design_problem(&model, &times, &LIMITS.parse::<Limits>()?)?;
     let names: Vec<&str> = pair.split(',').collect();
     let candidates = names
         .iter()
@@ -256,7 +256,7 @@ fn pin(records: usize, sampler: Option<SamplerKind>) -> Result<(), Box<dyn std::
         ..ModelFile::default()
     };
     let times = design_times(0.5, 1000.0)?;
-    let base = design_problem(&model, &times)?;
+    let base = design_problem(&model, &times, &LIMITS.parse::<Limits>()?)?;
     let targets = [Target::parse("R"), Target::parse("c_g/J")];
     let candidate = design::pin_candidate(&base, &BTreeMap::new(), &targets)?;
     let experiment = Experiment {

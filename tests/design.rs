@@ -36,6 +36,11 @@ fn scratch(name: &str) -> PathBuf {
     dir
 }
 
+/// The fixture's drive: 24 V, 300 A, 3000 rad/s.
+fn limits() -> Limits {
+    "U=±24,I=±300,omega=±3000".parse().unwrap()
+}
+
 fn one_error_line(o: &Output, needles: &[&str]) {
     assert!(!o.status.success(), "expected a failure");
     let err = String::from_utf8_lossy(&o.stderr);
@@ -51,7 +56,7 @@ fn one_error_line(o: &Output, needles: &[&str]) {
 fn tied_pair(duration: f64, rate: f64) -> Experiment {
     let model = read_model_file(&fixture("motor.toml")).unwrap();
     let times = design_times(duration, rate).unwrap();
-    let base = design_problem(&model, &times).unwrap();
+    let base = design_problem(&model, &times, &limits()).unwrap();
     let at = |pairs: &[(&str, f64)]| -> BTreeMap<String, f64> {
         pairs.iter().map(|(k, v)| (k.to_string(), *v)).collect()
     };
@@ -249,15 +254,10 @@ fn bad_options_get_one_clear_error_and_write_nothing() {
     ]);
     one_error_line(&o, &["--limits", "no input can meet"]);
     let o = run(&["--duration", "0.05", "--limits", "U=±24,I=±300"]);
-    one_error_line(&o, &["--limits", "all three"]);
-    // A drive base's input is a reference (a current command), not a voltage to search.
-    let hsm150 = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/hsm150/model.toml");
-    let o = run_on(
-        &hsm150,
-        false,
-        &["--pin", "J", "--duration", "0.05", "--limits", limits],
-    );
-    one_error_line(&o, &["reference", "voltage-driven"]);
+    one_error_line(&o, &["--limits", "speed"]);
+    // The voltage is this model's input: its limit cannot be left out.
+    let o = run(&["--duration", "0.05", "--limits", "I=±300,omega=±3000"]);
+    one_error_line(&o, &["--limits", "U=±VALUE"]);
     // Neither candidates nor a diagnosis to take them from.
     let o = run_on(&model, false, &["--duration", "0.05", "--limits", limits]);
     one_error_line(&o, &["--separate", "--diagnosis"]);
@@ -267,7 +267,7 @@ fn bad_options_get_one_clear_error_and_write_nothing() {
 /// A noisy record of the fixture's model with Coulomb friction of `t_c` N·m at 24 V.
 fn coulomb_record(t_c: f64, times: &[f64]) -> Problem {
     let model = read_model_file(&fixture("motor.toml")).unwrap();
-    let base = design_problem(&model, times).unwrap();
+    let base = design_problem(&model, times, &limits()).unwrap();
     let values = BTreeMap::from([("coulomb_friction.T_c".to_string(), t_c)]);
     let truth = Candidate::new(&base, "coulomb_friction", &values).unwrap();
     let motor = truth.problem.model.model(VoltageInput::Constant).unwrap();
@@ -284,7 +284,7 @@ fn coulomb_record(t_c: f64, times: &[f64]) -> Problem {
 fn without_a_diagnosis_the_candidates_sit_at_their_map_on_the_recording() {
     let times = design_times(0.2, 1000.0).unwrap();
     let recorded = coulomb_record(0.05, &times);
-    let base = design_problem(&recorded.model, &times).unwrap();
+    let base = design_problem(&recorded.model, &times, &limits()).unwrap();
     let names = ["load_torque".to_string(), "coulomb_friction".to_string()];
     let (candidates, sd) =
         design::candidates_without_diagnosis(&base, &names, Some(&recorded)).unwrap();
@@ -310,7 +310,7 @@ fn without_a_recording_the_candidates_sit_at_the_model_values_and_a_zero_term_at
 {
     let model = read_model_file(&fixture("motor.toml")).unwrap();
     let times = design_times(0.05, 400.0).unwrap();
-    let base = design_problem(&model, &times).unwrap();
+    let base = design_problem(&model, &times, &limits()).unwrap();
     let names = ["none".to_string(), "coulomb_friction".to_string()];
     let (candidates, sd) = design::candidates_without_diagnosis(&base, &names, None).unwrap();
     assert!(sd.is_none());
@@ -393,7 +393,7 @@ const DD: f64 = 2e-4;
 /// Viscous friction against quadratic drag (as strong at 2000 rad/s) on the fixture's motor.
 fn friction_pair(times: &[f64]) -> (Problem, Experiment) {
     let model = read_model_file(&fixture("motor.toml")).unwrap();
-    let base = design_problem(&model, times).unwrap();
+    let base = design_problem(&model, times, &limits()).unwrap();
     let at = |pairs: &[(&str, f64)]| -> BTreeMap<String, f64> {
         pairs.iter().map(|(k, v)| (k.to_string(), *v)).collect()
     };

@@ -12,7 +12,7 @@ use crate::design::{
     self, Candidate, DesignSettings, Experiment, Limits, SearchSettings, Target, design_problem,
     design_times,
 };
-use crate::io::{VoltageProfile, read_model_file, write_atomically, write_voltage_profile};
+use crate::io::{VoltageProfile, read_model_file, write_atomically, write_input_profile};
 use crate::motor::{MotorParam, VoltageInput};
 use crate::plot::{DesignChannel, DesignPlot, design_figure};
 use crate::study::Problem;
@@ -44,17 +44,19 @@ pub struct DesignArgs {
     /// Sampling rate [Hz].
     #[arg(long)]
     pub rate: f64,
-    /// The drive's limits, e.g. U=±24,I=±300,omega=±3000.
+    /// The drive's limits, e.g. U=±24,I=±300,omega=±3000 (a current_driven model: I=±6,omega=±500,
+    /// the current being what it commands).
     #[arg(long, allow_hyphen_values = true)]
     pub limits: String,
-    /// Voltage segments of the designed input.
+    /// Segments of the designed input (a voltage, or a current_driven model's current command).
     #[arg(long, default_value_t = 8)]
     pub segments: usize,
     #[arg(long, default_value_t = 2026)]
     pub seed: u64,
-    /// Noise σ of I [A] and ω [rad/s] (default: the diagnosis's or the fitted recording's,
-    /// else the paper's 2 and 10).
-    #[arg(long, num_args = 2, value_names = ["SD_I", "SD_OMEGA"])]
+    /// Noise σ of each channel the model measures: I [A] and ω [rad/s], or ω alone for a
+    /// current_driven model (default: the diagnosis's or the fitted recording's, else the
+    /// paper's 2 and 10).
+    #[arg(long, num_args = 1..=2, value_names = ["SD_I", "SD_OMEGA"])]
     pub noise_sd: Option<Vec<f64>>,
     /// Search starts (run in parallel).
     #[arg(long, default_value_t = 4)]
@@ -82,9 +84,11 @@ pub fn run(args: &DesignArgs) -> Result<(), AppError> {
         .map_err(|e| AppError::Usage(format!("--limits {}: {e}", args.limits)))?;
     let model = read_model_file(&args.model)?;
     let times = design_times(args.duration, args.rate)?;
-    let base = design_problem(&model, &times)?;
+    let base = design_problem(&model, &times, &limits)?;
+    let commanded = design::Commanded::of(model.base)?;
+    let channels = model.base.channels();
     let diagnosis = args.diagnosis.as_deref().map(read_diagnosis).transpose()?;
-    let mut noise_sd = noise_sd(args, diagnosis.as_ref())?;
+    let mut noise_sd = noise_sd(args, diagnosis.as_ref(), channels)?;
     let settings = DesignSettings {
         search: SearchSettings {
             segments: args.segments,
@@ -261,7 +265,8 @@ pub fn run(args: &DesignArgs) -> Result<(), AppError> {
     report["duration_s"] = json!(args.duration);
     report["rate_hz"] = json!(args.rate);
     report["segments"] = json!(args.segments);
-    report["noise_sd"] = json!({"I": noise_sd[0], "omega": noise_sd[1]});
+    report["noise_sd"] = json!(channels.iter().zip(&noise_sd).collect::<BTreeMap<_, _>>());
+    report["input"] = json!({"quantity": commanded.column(), "unit": commanded.unit()});
     report["search"] = json!(settings.search);
     report["draws"] = json!(settings.draws);
     report["runtime_s"] = json!(started.elapsed().as_secs_f64());
@@ -270,7 +275,19 @@ pub fn run(args: &DesignArgs) -> Result<(), AppError> {
             .into_iter()
             .collect::<BTreeMap<_, _>>()
     );
-    write_outputs(&args.out, &times, &values, &report, &figure, &noise_sd)?;
+    let input = (commanded.column(), commanded.unit());
+    let channels = channels
+        .iter()
+        .map(|&c| (c, model.base.channel_unit(c)))
+        .collect::<Vec<_>>();
+    let written = Written {
+        times: &times,
+        values: &values,
+        input,
+        channels: &channels,
+        noise_sd: &noise_sd,
+    };
+    write_outputs(&args.out, &written, &report, &figure)?;
     print_summary(&report, &args.out);
     Ok(())
 }
@@ -363,11 +380,17 @@ fn candidate_values(diagnosis: &Value, name: &str) -> Result<BTreeMap<String, f6
     Ok(values)
 }
 
-fn noise_sd(args: &DesignArgs, diagnosis: Option<&Value>) -> Result<Vec<f64>, AppError> {
+/// σ of each of `channels`: the command line's, else the diagnosis's fit's, else the paper's.
+fn noise_sd(
+    args: &DesignArgs,
+    diagnosis: Option<&Value>,
+    channels: &[&str],
+) -> Result<Vec<f64>, AppError> {
     if let Some(sd) = &args.noise_sd {
-        if sd.iter().any(|s| !(*s > 0.0 && s.is_finite())) {
+        if sd.len() != channels.len() || sd.iter().any(|s| !(*s > 0.0 && s.is_finite())) {
             return Err(AppError::Usage(format!(
-                "--noise-sd {sd:?} : must be positive numbers"
+                "--noise-sd {sd:?} : give one positive σ per channel the model measures ({})",
+                channels.join(", ")
             )));
         }
         return Ok(sd.clone());
@@ -375,25 +398,43 @@ fn noise_sd(args: &DesignArgs, diagnosis: Option<&Value>) -> Result<Vec<f64>, Ap
     for fit in ["fit_after", "fit_before"] {
         let sigma = diagnosis.map(|d| &d[fit]["sigma"]);
         if let Some(s) = sigma
-            && let (Some(i), Some(w)) = (s["I"].as_f64(), s["omega"].as_f64())
+            && let Some(sd) = channels.iter().map(|c| s[*c].as_f64()).collect()
         {
-            return Ok(vec![i, w]);
+            return Ok(sd);
         }
     }
-    Ok(crate::study::cases::NOISE_SD.to_vec())
+    Ok(channels
+        .iter()
+        .map(|c| design::default_noise_sd(c))
+        .collect())
+}
+
+/// What input.csv and design.png show: the sample times, the designed levels, the input's
+/// column and unit, the measured channels with their units and σ.
+struct Written<'a> {
+    times: &'a [f64],
+    values: &'a [f64],
+    input: (&'a str, &'a str),
+    channels: &'a [(&'a str, &'a str)],
+    noise_sd: &'a [f64],
 }
 
 fn write_outputs(
     out: &Path,
-    times: &[f64],
-    values: &[f64],
+    written: &Written,
     report: &Value,
     figure: &Figure,
-    noise_sd: &[f64],
 ) -> Result<(), AppError> {
+    let Written {
+        times,
+        values,
+        input,
+        ..
+    } = *written;
     std::fs::create_dir_all(out)?;
-    write_voltage_profile(
+    write_input_profile(
         &out.join("input.csv"),
+        input.0,
         &VoltageProfile {
             times: times.to_vec(),
             values: values.to_vec(),
@@ -402,18 +443,19 @@ fn write_outputs(
     let text = serde_json::to_string_pretty(report).map_err(|e| AppError::Output(e.to_string()))?;
     write_atomically(&out.join("design.json"), text.as_bytes())?;
     let m = times.len();
-    let channels = [("I", "A"), ("ω", "rad/s")]
-        .into_iter()
+    let channels = written
+        .channels
+        .iter()
         .enumerate()
         .map(|(c, (name, unit))| DesignChannel {
-            name: name.into(),
-            unit: unit.into(),
+            name: if *name == "omega" { "ω" } else { name }.into(),
+            unit: unit.to_string(),
             truth: figure.truth[c * m..(c + 1) * m].to_vec(),
             rival: figure
                 .rival
                 .as_ref()
                 .map_or(Vec::new(), |(_, y)| y[c * m..(c + 1) * m].to_vec()),
-            sigma: noise_sd[c],
+            sigma: written.noise_sd[c],
         })
         .collect();
     design_figure(
@@ -422,6 +464,7 @@ fn write_outputs(
             title: figure.title.clone(),
             times: times.to_vec(),
             input: values.to_vec(),
+            input_label: format!("{} [{}]", input.0, input.1),
             truth: figure.truth_name.clone(),
             rival: figure.rival.as_ref().map(|(name, _)| name.clone()),
             channels,

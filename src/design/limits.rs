@@ -1,9 +1,11 @@
 //! The drive's limits: the voltage a design may command, and the current and speed it may
-//! drive the motor to. A design that would pass one is refused, never clipped.
+//! drive the motor to (for a current-driven model the current is what it commands, and U is no
+//! input). A design that would pass one is refused, never clipped.
 
 use std::str::FromStr;
 
-/// Symmetric limits: |U| ≤ voltage, |I| ≤ current, |ω| ≤ speed.
+/// Symmetric limits: |U| ≤ voltage, |I| ≤ current, |ω| ≤ speed. The voltage may be infinite
+/// (not given): a current-driven model has no voltage input.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct Limits {
     #[serde(rename = "U")]
@@ -17,7 +19,8 @@ pub struct Limits {
 impl FromStr for Limits {
     type Err = String;
 
-    /// `U=±24,I=±300,omega=±3000` (`±`, `+-` or no sign; all three required).
+    /// `U=±24,I=±300,omega=±3000` (`±`, `+-` or no sign; I and omega required, U only where the
+    /// voltage is the input: see [`super::Commanded::level_limit`]).
     fn from_str(text: &str) -> Result<Self, String> {
         let mut found: [Option<f64>; 3] = [None; 3];
         for item in text.split(',').map(str::trim).filter(|s| !s.is_empty()) {
@@ -50,13 +53,27 @@ impl FromStr for Limits {
             }
         }
         match found {
-            [Some(voltage), Some(current), Some(speed)] => Ok(Self {
-                voltage,
+            [voltage, Some(current), Some(speed)] => Ok(Self {
+                voltage: voltage.unwrap_or(f64::INFINITY),
                 current,
                 speed,
             }),
-            _ => Err("give all three limits, e.g. U=±24,I=±300,omega=±3000".into()),
+            _ => Err(
+                "give the current and speed limits, and the voltage limit for a \
+                      voltage-driven model, e.g. U=±24,I=±300,omega=±3000"
+                    .into(),
+            ),
         }
+    }
+}
+
+/// As the command line takes them; a voltage that is not limited is left out.
+impl std::fmt::Display for Limits {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if self.voltage.is_finite() {
+            write!(f, "U=±{},", self.voltage)?;
+        }
+        write!(f, "I=±{},omega=±{}", self.current, self.speed)
     }
 }
 
@@ -112,8 +129,12 @@ mod tests {
     fn limits_parse_and_refuse() {
         let l: Limits = "U=±24, I=+-300,omega=3000".parse().unwrap();
         assert_eq!((l.voltage, l.current, l.speed), (24.0, 300.0, 3000.0));
+        let current_only: Limits = "I=±6,omega=±500".parse().unwrap();
+        assert_eq!(current_only.voltage, f64::INFINITY);
+        assert_eq!(current_only.to_string(), "I=±6,omega=±500");
         for bad in [
             "U=±24,I=±300",
+            "U=±24,omega=±300",
             "U=0,I=1,omega=1",
             "V=1",
             "U=x,I=1,omega=1",

@@ -1,9 +1,11 @@
 //! `motorcal design`: the input to record next. Within the drive's limits, a piecewise-constant
-//! voltage of N segments that either tells candidate explanations apart (the expected evidence
-//! gap of each candidate as the truth over its best-fitting rival, [`separate`]) or pins named
-//! parameters (D-optimal on the Fisher matrix of the forward sensitivities, [`pin`]); beside it
-//! the fixed experiments `diagnose` tries for a tie ([`crate::discover::TIE_EXPERIMENTS`]) and
-//! for pinning the model's constant U.
+//! voltage of N segments — for a `current_driven` model a current command ([`Commanded`]) —
+//! that either tells candidate explanations apart (the expected evidence gap of each candidate
+//! as the truth over its best-fitting rival, [`separate`]) or pins named parameters (D-optimal
+//! on the Fisher matrix of the forward sensitivities, [`pin`]); beside it the fixed experiments
+//! `diagnose` tries for a tie ([`crate::discover::TIE_EXPERIMENTS`]) and for pinning the
+//! constant input: at the model's U, or for a current command at the largest current within
+//! the limits ([`fixed_inputs`]).
 //!
 //! The files: `profile` (the input and its free coordinates), `limits`, `experiment` (the
 //! candidates at their estimates, the sampling and σ), `fitted` (the candidates' estimates
@@ -16,7 +18,9 @@
 //! the continuous switching times with the current and speed limits 2% tighter ([`MARGIN`]);
 //! the input written switches at the first sample at or after each switching time, and is
 //! checked again against the limits themselves — an input that then passes one is an error,
-//! never clipped.
+//! never clipped. A current-driven model is integrated at its samples with the current held
+//! over each sample interval ([`crate::motor::SampledDrive`]): its search sees a switch at the
+//! first sample at or after it already, so what it finds is what is written.
 
 mod experiment;
 mod fitted;
@@ -27,7 +31,10 @@ mod rivals;
 mod search;
 mod separate;
 
-pub use experiment::{Candidate, Experiment, design_problem, design_times, parse_candidate};
+pub use experiment::{
+    Candidate, Commanded, Experiment, default_noise_sd, design_problem, design_times,
+    parse_candidate,
+};
 pub use fitted::candidates_without_diagnosis;
 pub use limits::Limits;
 pub use pin::{Pinned, Target, fisher, pin_candidate, pinned};
@@ -89,7 +96,7 @@ pub struct FixedSeparation {
 pub struct SeparationDesign {
     pub profile: Profile,
     pub times: Vec<f64>,
-    /// The voltage at each sample time: `input.csv`.
+    /// The voltage (a current-driven model: the current) at each sample time: `input.csv`.
     pub values: Vec<f64>,
     pub check: InputCheck,
     /// The smallest expected gap over the truths (the design's guarantee), its truth's sd.
@@ -139,7 +146,8 @@ fn check(
         }
     }
     if let VoltageInput::Held { values, .. } = input {
-        within &= values.iter().all(|u| u.abs() <= limits.voltage);
+        let bound = experiment.commanded()?.level_limit(limits)?;
+        within &= values.iter().all(|u| u.abs() <= bound);
     }
     Ok(InputCheck {
         input: name.into(),
@@ -148,10 +156,28 @@ fn check(
     })
 }
 
-/// Refuses limits that no useful input can meet: a constant 1% of the voltage limit already
-/// drives a candidate past the current or speed limit.
+/// Refuses a σ per channel that does not match the candidates' channels, and limits that no
+/// useful input can meet: a constant 1% of the level limit (the voltage, or a current command)
+/// already drives a candidate past the current or speed limit.
 fn check_possible(experiment: &Experiment, limits: &Limits) -> Result<(), Error> {
-    let u = 0.01 * limits.voltage;
+    let channels = experiment.channels();
+    if experiment.noise_sd.len() != channels.len()
+        || experiment
+            .noise_sd
+            .iter()
+            .any(|s| !(*s > 0.0 && s.is_finite()))
+    {
+        return Err(Error::setting(
+            "noise-sd",
+            format!("{:?}", experiment.noise_sd),
+            format!(
+                "give one positive σ per channel the model measures ({})",
+                channels.join(", ")
+            ),
+        ));
+    }
+    let commanded = experiment.commanded()?;
+    let u = 0.01 * commanded.level_limit(limits)?;
     let input = held(&experiment.times, vec![u; experiment.times.len()]);
     let c = check(experiment, "probe", &input, limits)?;
     if !c.within_limits {
@@ -162,13 +188,12 @@ fn check_possible(experiment: &Experiment, limits: &Limits) -> Result<(), Error>
             .collect();
         return Err(Error::setting(
             "limits",
+            limits,
             format!(
-                "U=±{},I=±{},omega=±{}",
-                limits.voltage, limits.current, limits.speed
-            ),
-            format!(
-                "no input can meet these limits: a constant {u} V (1% of the voltage limit) \
+                "no input can meet these limits: a constant {u} {} (1% of the {} limit) \
                  already reaches {}",
+                commanded.unit(),
+                commanded.column(),
                 peaks.join(", ")
             ),
         ));
@@ -199,7 +224,7 @@ fn search_profile<F: Fn(&VoltageInput) -> f64 + Sync>(
             "a design needs at least one segment",
         ));
     }
-    let u_max = settings.limits.voltage;
+    let u_max = experiment.commanded()?.level_limit(&settings.limits)?;
     let starts: Vec<Vec<f64>> = search::starts(&settings.search, duration, u_max)
         .iter()
         .map(|p| p.to_free(u_max))
@@ -220,22 +245,53 @@ fn search_profile<F: Fn(&VoltageInput) -> f64 + Sync>(
     Ok((profile, values, input, c))
 }
 
-/// The fixed experiments at the model's U: (name, input).
-fn fixed_inputs(experiment: &Experiment, profiles: &[InputProfile]) -> Vec<(String, VoltageInput)> {
-    let u = experiment
-        .candidates
-        .first()
-        .map_or(0.0, |c| c.problem.model.motor.voltage);
-    profiles
-        .iter()
-        .map(|p| {
-            let input = match p.voltage(u, &experiment.times) {
-                VoltageInput::Constant => held(&experiment.times, vec![u; experiment.times.len()]),
-                held => held,
-            };
-            (p.name().to_string(), input)
-        })
-        .collect()
+/// The fixed experiments: each profile at the model's U, or for a current command at the
+/// largest current within the current limit at which every candidate stays within the speed
+/// limit (the strongest such experiment the drive allows; a constant load can make that zero).
+/// (name, input).
+fn fixed_inputs(
+    experiment: &Experiment,
+    profiles: &[InputProfile],
+    limits: &Limits,
+) -> Result<Vec<(String, VoltageInput)>, Error> {
+    let times = &experiment.times;
+    let at = |p: &InputProfile, u: f64| match p.voltage(u, times) {
+        VoltageInput::Constant => held(times, vec![u; times.len()]),
+        held => held,
+    };
+    let mut out = Vec::new();
+    for p in profiles {
+        let u = match experiment.commanded()? {
+            Commanded::Voltage => experiment
+                .candidates
+                .first()
+                .map_or(0.0, |c| c.problem.model.motor.voltage),
+            Commanded::Current => {
+                let within = |u: f64| -> Result<bool, Error> {
+                    Ok(check(experiment, p.name(), &at(p, u), limits)?.within_limits)
+                };
+                let mut high = limits.current;
+                let mut low = 0.0;
+                if within(high)? {
+                    low = high;
+                } else {
+                    // Bisection on the level: 20 halvings leave it within 1e-6 of the limit's
+                    // bound, and `low` is within the limits at every step.
+                    for _ in 0..20 {
+                        let mid = 0.5 * (low + high);
+                        if within(mid)? {
+                            low = mid;
+                        } else {
+                            high = mid;
+                        }
+                    }
+                }
+                low
+            }
+        };
+        out.push((p.name().to_string(), at(p, u)));
+    }
+    Ok(out)
 }
 
 fn worst(gaps: &[ExpectedGap]) -> (f64, f64) {
@@ -269,7 +325,8 @@ pub fn separate(
     let gaps = expected_gaps(experiment, &input, &settings.limits, settings.draws, seed)?;
     let (expected_gap_nats, spread_nats) = worst(&gaps);
     let mut fixed_experiments = Vec::new();
-    for (name, fixed) in fixed_inputs(experiment, &crate::discover::TIE_EXPERIMENTS) {
+    let profiles = crate::discover::TIE_EXPERIMENTS;
+    for (name, fixed) in fixed_inputs(experiment, &profiles, &settings.limits)? {
         let check = self::check(experiment, &name, &fixed, &settings.limits)?;
         let gaps = expected_gaps(experiment, &fixed, &no_limits(), settings.draws, seed)?;
         let (g, s) = worst(&gaps);
@@ -322,7 +379,7 @@ pub fn pin(
         crate::discover::TIE_EXPERIMENTS[0],
         crate::discover::TIE_EXPERIMENTS[1],
     ];
-    for (name, fixed) in fixed_inputs(experiment, &profiles) {
+    for (name, fixed) in fixed_inputs(experiment, &profiles, &settings.limits)? {
         let check = self::check(experiment, &name, &fixed, &settings.limits)?;
         fixed_experiments.push((check, self::pinned(candidate, experiment, targets, &fixed)?));
     }

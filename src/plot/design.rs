@@ -15,8 +15,10 @@ pub struct DesignPlot {
     pub title: String,
     /// Sample times [s].
     pub times: Vec<f64>,
-    /// The designed voltage at the sample times [V].
+    /// The designed input at the sample times: a voltage, or a current command.
     pub input: Vec<f64>,
+    /// The input's axis label, e.g. `U [V]` or `I [A]` (a current-driven model's command).
+    pub input_label: String,
     /// The candidate taken as the truth, and its best-fitting rival (`None` when pinning: the
     /// model alone is drawn, and no difference).
     pub truth: String,
@@ -114,7 +116,7 @@ pub fn design_figure(path: &Path, plot: &DesignPlot) -> Result<(), PlotError> {
                 x: xa.clone(),
                 y: input_axis.unwrap_or_else(|| Axis::fallback(false)),
                 x_desc: "",
-                y_desc: "U [V]",
+                y_desc: &plot.input_label,
                 x_ticks: false,
                 x_area: 0,
                 y_area,

@@ -539,6 +539,7 @@ fn design_example(rival: bool) -> DesignPlot {
         title: "design".into(),
         times: times.clone(),
         input,
+        input_label: "U [V]".into(),
         truth: "coulomb_friction".into(),
         rival: rival.then(|| "load_torque".into()),
         channels: vec![
