@@ -1,0 +1,333 @@
+//! `motorcal design` on a `current_driven` model: the designed input is a current command
+//! (`input.csv` is `t,I`) within the current limit that keeps ω within the speed limit, it
+//! separates a tie better than the fixed reversal and step (run in current), a `position_loop`
+//! model is refused by name, and `simulate --input` plays a `t,I` file back into a recording —
+//! the loop design → simulate → diagnose closes.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use motorcal::design::{
+    self, Candidate, DesignSettings, Experiment, Limits, SearchSettings, design_problem,
+    design_times, held,
+};
+use motorcal::io::{ChannelMap, read_input_profile, read_model_file, read_recording_for};
+use motorcal::motor::Base;
+use motorcal::study::{Problem, held_input_record};
+
+/// J = 1e-4 kg·m², d = 6e-5 N·m·s/rad, c_g = 0.0458 N·m/A; J calibrated.
+fn model_path() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/design/current_driven.toml")
+}
+
+const LIMITS: &str = "I=±3,omega=±300";
+
+fn motorcal(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_motorcal"))
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!(
+        "motorcal-design-current-{}-{name}",
+        std::process::id()
+    ));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn one_error_line(o: &Output, needles: &[&str]) {
+    assert!(!o.status.success(), "expected a failure");
+    let err = String::from_utf8_lossy(&o.stderr);
+    let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert_eq!(lines.len(), 1, "expected one error line, got: {err}");
+    assert!(!err.contains("panicked"), "{err}");
+    for n in needles {
+        assert!(err.contains(n), "'{err}' does not mention '{n}'");
+    }
+}
+
+/// The largest |ω| of each candidate under a held current.
+fn peak_speeds(experiment: &Experiment, current: &[f64]) -> Vec<f64> {
+    let input = held(&experiment.times, current.to_vec());
+    experiment
+        .candidates
+        .iter()
+        .map(|c| {
+            let forward = c.forward(&input, &experiment.times).unwrap();
+            assert_eq!(forward.channels(), ["omega"]);
+            let mut y = vec![0.0; forward.n_outputs()];
+            forward.simulate(&c.theta, &mut y).unwrap();
+            y.iter().fold(0.0f64, |a, v| a.max(v.abs()))
+        })
+        .collect()
+}
+
+#[test]
+fn a_current_driven_design_writes_a_current_within_the_limits() {
+    let dir = scratch("limits");
+    let out = dir.join("design");
+    let o = motorcal(&[
+        "design",
+        "--model",
+        model_path().to_str().unwrap(),
+        "--separate",
+        "none,coulomb_friction",
+        "--duration",
+        "0.25",
+        "--rate",
+        "400",
+        "--limits",
+        LIMITS,
+        "--noise-sd",
+        "1",
+        "--segments",
+        "4",
+        "--starts",
+        "2",
+        "--draws",
+        "2",
+        "--no-rival-check",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = std::fs::read_to_string(out.join("input.csv")).unwrap();
+    assert!(text.starts_with("t,I\n"), "{}", &text[..20.min(text.len())]);
+    let profile = read_input_profile(&out.join("input.csv"), "I").unwrap();
+    let limits: Limits = LIMITS.parse().unwrap();
+    assert!(profile.values.iter().all(|i| i.abs() <= limits.current));
+    // The search uses the range it is given: the current is not left near zero.
+    let largest = profile.values.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    assert!(largest > 0.3 * limits.current, "largest |I| {largest}");
+
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("design.json")).unwrap()).unwrap();
+    assert_eq!(report["input"]["quantity"], "I");
+    assert_eq!(report["input"]["unit"], "A");
+    assert_eq!(report["noise_sd"], serde_json::json!({"omega": 1.0}));
+    assert!(report["peaks"].get("I").is_none(), "{}", report["peaks"]);
+
+    // The written current, played into each candidate at the values the design used, keeps ω
+    // within the speed limit.
+    let model = read_model_file(&model_path()).unwrap();
+    let base = design_problem(&model, &profile.times, &limits).unwrap();
+    let candidates = ["none", "coulomb_friction"]
+        .iter()
+        .map(|name| {
+            let values: BTreeMap<String, f64> = report["candidates_at"]["values"][name]
+                .as_object()
+                .unwrap()
+                .iter()
+                .map(|(k, v)| (k.clone(), v.as_f64().unwrap()))
+                .collect();
+            Candidate::new(&base, name, &values).unwrap()
+        })
+        .collect();
+    let experiment = Experiment {
+        candidates,
+        times: profile.times.clone(),
+        noise_sd: vec![1.0],
+    };
+    for peak in peak_speeds(&experiment, &profile.values) {
+        assert!(peak <= limits.speed, "|ω| reaches {peak}");
+        assert!(peak > 0.1 * limits.speed, "|ω| only reaches {peak}");
+    }
+}
+
+/// A record of `truth_terms` on the fixture's model under a constant 1 A, which never reverses:
+/// the record on which friction and a constant load (or two speed laws) tie.
+fn constant_current_record(truth_terms: &str, times: &[f64]) -> Problem {
+    let text = std::fs::read_to_string(model_path())
+        .unwrap()
+        .replace("[drive]", &format!("{truth_terms}\n[drive]"));
+    let truth = motorcal::io::parse_model_file(&text, Path::new("truth.toml")).unwrap();
+    let (recording, _) = held_input_record(
+        &truth,
+        times,
+        vec![1.0; times.len()],
+        &[0.0, 1.0],
+        7,
+        "constant 1 A",
+    )
+    .unwrap();
+    Problem {
+        label: "recorded".into(),
+        recordings: vec![recording],
+        model: read_model_file(&model_path()).unwrap(),
+        reference: None,
+    }
+}
+
+#[test]
+fn a_designed_current_separates_a_tie_better_than_the_fixed_experiments() {
+    let times = design_times(0.25, 400.0).unwrap();
+    let limits: Limits = LIMITS.parse().unwrap();
+    let settings = DesignSettings {
+        search: SearchSettings {
+            segments: 4,
+            starts: 2,
+            iterations: 200,
+            seed: 3,
+        },
+        limits,
+        draws: 4,
+    };
+    let cases = [
+        (
+            "[terms.coulomb_friction]\nT_c = 0.02\n",
+            ["coulomb_friction", "load_torque"],
+        ),
+        (
+            "[terms.viscous_friction]\nDd = 1.0e-4\n",
+            ["viscous_friction", "quadratic_drag"],
+        ),
+    ];
+    for (truth, pair) in cases {
+        let recorded = constant_current_record(truth, &times);
+        let base = design_problem(&recorded.model, &times, &limits).unwrap();
+        let names: Vec<String> = pair.iter().map(|s| s.to_string()).collect();
+        let (candidates, sd) =
+            design::candidates_without_diagnosis(&base, &names, Some(&recorded)).unwrap();
+        let sd = sd.unwrap();
+        assert_eq!(sd.len(), 1, "a current-driven record measures ω alone");
+        let experiment = Experiment {
+            candidates,
+            times: times.clone(),
+            noise_sd: sd,
+        };
+        let d = design::separate(&experiment, &settings).unwrap();
+        assert!(d.values.iter().all(|i| i.abs() <= limits.current));
+        assert!(d.check.within_limits);
+        let fixed: Vec<(String, f64)> = d
+            .fixed_experiments
+            .iter()
+            .map(|f| (f.check.input.clone(), f.expected_gap_nats))
+            .collect();
+        eprintln!(
+            "{pair:?}: designed {:.1} ± {:.1} nats, fixed {fixed:?}",
+            d.expected_gap_nats, d.spread_nats
+        );
+        assert!(
+            d.expected_gap_nats >= 10.0,
+            "{pair:?}: {}",
+            d.expected_gap_nats
+        );
+        for f in &d.fixed_experiments {
+            // The fixed experiments run in current, at the largest level within the limits.
+            assert!(
+                f.check.within_limits,
+                "{pair:?}: {} passes them",
+                f.check.input
+            );
+            assert!(
+                d.expected_gap_nats > f.expected_gap_nats,
+                "{pair:?}: designed {} nats, {} {} nats",
+                d.expected_gap_nats,
+                f.check.input,
+                f.expected_gap_nats
+            );
+        }
+    }
+}
+
+#[test]
+fn a_position_loop_model_is_refused_by_name() {
+    let emps = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/emps/model.toml");
+    let out = scratch("position").join("design");
+    let o = motorcal(&[
+        "design",
+        "--model",
+        emps.to_str().unwrap(),
+        "--pin",
+        "J",
+        "--duration",
+        "0.05",
+        "--rate",
+        "400",
+        "--limits",
+        "U=±24,I=±300,omega=±3000",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    one_error_line(&o, &["--model", "position_loop", "reference position"]);
+    assert!(!out.exists());
+    let model = read_model_file(&emps).unwrap();
+    let times = design_times(0.05, 400.0).unwrap();
+    let limits: Limits = "U=±24,I=±300,omega=±3000".parse().unwrap();
+    assert!(design_problem(&model, &times, &limits).is_err());
+}
+
+#[test]
+fn simulate_plays_a_current_file_into_a_current_driven_recording() {
+    let dir = scratch("simulate");
+    let input = dir.join("input.csv");
+    let mut text = String::from("t,I\n");
+    for i in 1..=200 {
+        let current = if i <= 120 { 2.0 } else { -2.0 };
+        text.push_str(&format!("{},{current}\n", i as f64 * 1e-3));
+    }
+    std::fs::write(&input, &text).unwrap();
+    let model = model_path();
+    let out = dir.join("sim");
+    let o = motorcal(&[
+        "simulate",
+        "--truth",
+        model.to_str().unwrap(),
+        "--input",
+        input.to_str().unwrap(),
+        "--noise-sd",
+        "0",
+        "0.5",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let rec = read_recording_for(
+        &out.join("recording.csv"),
+        &ChannelMap::default(),
+        Base::CurrentDriven,
+    )
+    .unwrap();
+    assert_eq!(rec.n_samples(), 200);
+    assert_eq!(rec.time[0], 1e-3);
+    let current = rec.input("I").expect("the recording carries I");
+    assert_eq!((current[0], current[119], current[120]), (2.0, 2.0, -2.0));
+    // 2 A accelerates the rotor for 0.12 s (c_g·I/J ≈ 900 rad/s²), then −2 A brakes it.
+    let omega = rec.channel("omega").unwrap();
+    assert!(
+        omega[119] > 60.0,
+        "ω {} after the positive current",
+        omega[119]
+    );
+    assert!(
+        omega[199] < omega[119] - 30.0,
+        "ω {} after braking",
+        omega[199]
+    );
+    let realised = String::from_utf8_lossy(&o.stdout);
+    assert!(realised.contains("omega"), "{realised}");
+
+    // A voltage file, or a profile, is not a current command.
+    let voltage = dir.join("voltage.csv");
+    std::fs::write(&voltage, text.replace("t,I", "t,U")).unwrap();
+    let bad = dir.join("bad");
+    let run = |input: &str| {
+        motorcal(&[
+            "simulate",
+            "--truth",
+            model.to_str().unwrap(),
+            "--input",
+            input,
+            "--out",
+            bad.to_str().unwrap(),
+        ])
+    };
+    one_error_line(&run(voltage.to_str().unwrap()), &["t,I", "'I'"]);
+    one_error_line(&run("step"), &["--input step", "current_driven", "t,I"]);
+    assert!(!bad.exists());
+}
