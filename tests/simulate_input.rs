@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 use std::process::{Command, Output};
 
-use motorcal::io::{ChannelMap, read_recording};
+use motorcal::io::{ChannelMap, read_model_file, read_recording, read_recording_for};
 
 fn motorcal(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_motorcal"))
@@ -153,7 +153,12 @@ fn a_drive_base_truth_is_simulated_and_its_channels_named() {
         .find(|l| l.starts_with("realised noise sd:"))
         .expect("the noise line");
     assert!(line.contains("omega") && !line.contains(','), "{line}");
-    assert!(out.join("recording.csv").exists());
+    // Its columns are named as the model file written beside it names them (HSM150's t_s,
+    // w_rad_s, I_A), so that file reads the record back.
+    let model = read_model_file(&out.join("motor.toml")).unwrap();
+    let rec = read_recording_for(&out.join("recording.csv"), &model.channels, model.base).unwrap();
+    assert_eq!(rec.input("I").unwrap(), [1.0, 1.0, -1.0]);
+    assert_eq!(rec.channel("omega").unwrap().len(), 3);
     std::fs::remove_dir_all(&out).unwrap();
     one_error_line(&simulate("constant"), &["--input constant", "t,I"]);
     assert!(!out.exists());

@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use crate::io::{
-    ModelFile, read_input_profile, read_model_file, write_model_file, write_recording,
+    ModelFile, read_input_profile, read_model_file, write_model_file, write_recording_as,
 };
 use crate::motor::{MotorParameters, VoltageInput};
 pub use crate::study::InputProfile;
@@ -297,7 +297,8 @@ pub fn simulate(options: &SimulateOptions) -> Result<SimulateReport, AppError> {
         realised_noise_sd: data.realised_noise_sd(),
         channels: data.channel_names.clone(),
     };
-    write_recording(&report.recording, &recording)?;
+    // Named as the model file written beside it names them, so that it reads the record back.
+    write_recording_as(&report.recording, &recording, &nominal_file.channels)?;
     write_model_file(&report.nominal, &nominal_file)?;
     write_model_file(&report.truth, &truth_file)?;
     Ok(report)

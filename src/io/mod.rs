@@ -30,7 +30,9 @@ pub use model_file::{
     write_model_file,
 };
 pub use model_tables::{CalibrateEntry, DiscrepancyChoice};
-pub use recording::{ChannelMap, Recording, read_recording, read_recording_for, write_recording};
+pub use recording::{
+    ChannelMap, Recording, read_recording, read_recording_for, write_recording, write_recording_as,
+};
 
 /// Provenance written into every output: crate version and the commit it was built from.
 pub fn provenance() -> Vec<(String, String)> {

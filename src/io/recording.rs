@@ -341,24 +341,30 @@ pub fn read_recording_for(
 
 /// Writes `t`, the channels and `U` (when recorded) as CSV with round-trip precision.
 pub fn write_recording(path: &Path, recording: &Recording) -> io::Result<()> {
+    write_recording_as(path, recording, &ChannelMap::default())
+}
+
+/// As [`write_recording`], each column named as `map` names it: the file a model file with that
+/// `[channels]` table reads back (a rig's `t_s`, `w_rad_s`, …).
+pub fn write_recording_as(path: &Path, recording: &Recording, map: &ChannelMap) -> io::Result<()> {
     let invalid =
         |message: String| with_path(path, io::Error::new(io::ErrorKind::InvalidInput, message));
     let n = recording.time.len();
-    let mut columns: Vec<(&str, &[f64])> = vec![("t", &recording.time)];
+    let mut columns: Vec<(&str, &[f64])> = vec![(map.column("t"), &recording.time)];
     columns.extend(
         recording
             .channels
             .iter()
-            .map(|(name, v)| (name.as_str(), v.as_slice())),
+            .map(|(name, v)| (map.column(name), v.as_slice())),
     );
     if let Some(u) = &recording.voltage {
-        columns.push(("U", u));
+        columns.push((map.column("U"), u));
     }
     columns.extend(
         recording
             .inputs
             .iter()
-            .map(|(name, v)| (name.as_str(), v.as_slice())),
+            .map(|(name, v)| (map.column(name), v.as_slice())),
     );
     for (name, v) in &columns {
         if v.len() != n {
