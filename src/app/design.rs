@@ -58,7 +58,8 @@ pub struct DesignArgs {
     /// paper's 2 and 10).
     #[arg(long, num_args = 1..=2, value_names = ["SD_I", "SD_OMEGA"])]
     pub noise_sd: Option<Vec<f64>>,
-    /// Search starts (run in parallel).
+    /// Seeded search starts (run in parallel; a current_driven design also starts from its
+    /// fixed experiments).
     #[arg(long, default_value_t = 4)]
     pub starts: usize,
     /// Noisy records per candidate for the reported gap and its spread.

@@ -210,10 +210,14 @@ fn tightened(limits: &Limits) -> Limits {
 }
 
 /// The search on `cost`, the profile it ends at, and that profile sampled and checked.
+/// `extra` starts go beside the seeded ones ([`fixed_starts`]); with `judge`, the start whose
+/// end it rates lowest wins, not the one `cost` rates lowest (see [`separate`]).
 fn search_profile<F: Fn(&VoltageInput) -> f64 + Sync>(
     experiment: &Experiment,
     settings: &DesignSettings,
+    extra: &[Profile],
     cost: F,
+    judge: Option<&dyn Fn(&VoltageInput) -> f64>,
 ) -> Result<(Profile, Vec<f64>, VoltageInput, InputCheck), Error> {
     let duration = *experiment.times.last().unwrap_or(&0.0);
     let n = settings.search.segments;
@@ -227,11 +231,21 @@ fn search_profile<F: Fn(&VoltageInput) -> f64 + Sync>(
     let u_max = experiment.commanded()?.level_limit(&settings.limits)?;
     let starts: Vec<Vec<f64>> = search::starts(&settings.search, duration, u_max)
         .iter()
+        .chain(extra)
         .map(|p| p.to_free(u_max))
         .collect();
     let free = |z: &[f64]| cost(&Profile::from_free(z, n, duration, u_max).continuous());
-    let (z, _) = search::minimise(&starts, settings.search.iterations, &free);
-    let profile = Profile::from_free(&z, n, duration, u_max);
+    let ends = search::minimise_each(&starts, settings.search.iterations, &free);
+    let rated: Vec<f64> = match judge {
+        Some(judge) => ends
+            .iter()
+            .map(|(z, _)| judge(&Profile::from_free(z, n, duration, u_max).continuous()))
+            .collect(),
+        None => ends.iter().map(|(_, c)| *c).collect(),
+    };
+    // The first among equals: the same end whatever the thread count.
+    let best = (1..ends.len()).fold(0, |b, i| if rated[i] < rated[b] { i } else { b });
+    let profile = Profile::from_free(&ends[best].0, n, duration, u_max);
     let values = profile.sampled(&experiment.times);
     let input = held(&experiment.times, values.clone());
     let c = check(experiment, "designed", &input, &settings.limits)?;
@@ -294,6 +308,33 @@ fn fixed_inputs(
     Ok(out)
 }
 
+/// For a current command, the fixed experiments as search starts, at the largest level within
+/// the search's (tightened) limits: each is then a feasible start, and the designed input's
+/// noise-free objective is at least theirs (the search keeps its best point). Run at the
+/// limits, they are strong: the seeded starts alone were seen to end far below the reversal
+/// (HSM150's model, Coulomb friction against a load: 268 nats against 1842). None for a
+/// voltage: its fixed experiments run at the model's U, often past the limits.
+fn fixed_starts(
+    experiment: &Experiment,
+    profiles: &[InputProfile],
+    search_limits: &Limits,
+    segments: usize,
+) -> Result<Vec<Profile>, Error> {
+    if experiment.commanded()? != Commanded::Current {
+        return Ok(Vec::new());
+    }
+    let duration = *experiment.times.last().unwrap_or(&0.0);
+    Ok(fixed_inputs(experiment, profiles, search_limits)?
+        .into_iter()
+        .filter_map(|(_, input)| match input {
+            VoltageInput::Held { times, values } => {
+                Profile::from_held(&times, &values, segments, duration)
+            }
+            VoltageInput::Constant => None,
+        })
+        .collect())
+}
+
 fn worst(gaps: &[ExpectedGap]) -> (f64, f64) {
     gaps.iter()
         .map(|g| (g.expected_gap_nats, g.sd_nats))
@@ -320,12 +361,29 @@ pub fn separate(
             Ok(e) => -e.worst(),
             Err(_) => INFEASIBLE * 1e3,
         };
-    let (profile, values, input, check) = search_profile(experiment, settings, cost)?;
+    let profiles = crate::discover::TIE_EXPERIMENTS;
+    let n = settings.search.segments;
+    let extra = fixed_starts(experiment, &profiles, &search_limits, n)?;
+    // The search's rival fits are a few Gauss–Newton steps: an input where they stop short
+    // looks separating and is not. With the fixed experiments among the starts the ends are
+    // rated by fits to convergence, so that the design is not chosen below a start it left.
+    let polished =
+        |input: &VoltageInput| match noise_free_leads(experiment, input, &search_limits, true) {
+            Ok(Evaluation::Infeasible { excess }) => INFEASIBLE * (1.0 + excess),
+            Ok(e) => -e.worst(),
+            Err(_) => INFEASIBLE * 1e3,
+        };
+    let judge: Option<&dyn Fn(&VoltageInput) -> f64> = if extra.is_empty() {
+        None
+    } else {
+        Some(&polished)
+    };
+    let (profile, values, input, check) =
+        search_profile(experiment, settings, &extra, cost, judge)?;
     let seed = settings.search.seed;
     let gaps = expected_gaps(experiment, &input, &settings.limits, settings.draws, seed)?;
     let (expected_gap_nats, spread_nats) = worst(&gaps);
     let mut fixed_experiments = Vec::new();
-    let profiles = crate::discover::TIE_EXPERIMENTS;
     for (name, fixed) in fixed_inputs(experiment, &profiles, &settings.limits)? {
         let check = self::check(experiment, &name, &fixed, &settings.limits)?;
         let gaps = expected_gaps(experiment, &fixed, &no_limits(), settings.draws, seed)?;
@@ -371,14 +429,16 @@ pub fn pin(
         Ok(Err(excess)) => INFEASIBLE * (1.0 + excess),
         Err(_) => INFEASIBLE * 1e3,
     };
-    let (profile, values, input, check) = search_profile(experiment, settings, cost)?;
-    let pinned = pinned(candidate, experiment, targets, &input)?;
-    let mut fixed_experiments = Vec::new();
     let profiles = [
         InputProfile::Constant,
         crate::discover::TIE_EXPERIMENTS[0],
         crate::discover::TIE_EXPERIMENTS[1],
     ];
+    let n = settings.search.segments;
+    let extra = fixed_starts(experiment, &profiles, &search_limits, n)?;
+    let (profile, values, input, check) = search_profile(experiment, settings, &extra, cost, None)?;
+    let pinned = pinned(candidate, experiment, targets, &input)?;
+    let mut fixed_experiments = Vec::new();
     for (name, fixed) in fixed_inputs(experiment, &profiles, &settings.limits)? {
         let check = self::check(experiment, &name, &fixed, &settings.limits)?;
         fixed_experiments.push((check, self::pinned(candidate, experiment, targets, &fixed)?));

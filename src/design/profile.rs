@@ -53,6 +53,41 @@ impl Profile {
         z
     }
 
+    /// A held input (values at `times`) as a profile of `n` segments on `duration`: each
+    /// switch halfway between the samples it falls between, the longest segments split (at
+    /// equal levels) until there are `n`; `None` when the input has more than `n` levels.
+    pub fn from_held(times: &[f64], values: &[f64], n: usize, duration: f64) -> Option<Self> {
+        let mut levels = vec![*values.first()?];
+        let mut switches = Vec::new();
+        for i in 1..values.len().min(times.len()) {
+            if values[i] != values[i - 1] {
+                levels.push(values[i]);
+                switches.push(0.5 * (times[i - 1] + times[i]));
+            }
+        }
+        if levels.len() > n {
+            return None;
+        }
+        while levels.len() < n {
+            let bounds: Vec<f64> = std::iter::once(0.0)
+                .chain(switches.iter().copied())
+                .chain(std::iter::once(duration))
+                .collect();
+            let longest = (0..levels.len())
+                .max_by(|&a, &b| {
+                    (bounds[a + 1] - bounds[a]).total_cmp(&(bounds[b + 1] - bounds[b]))
+                })
+                .unwrap_or(0);
+            levels.insert(longest, levels[longest]);
+            switches.insert(longest, 0.5 * (bounds[longest] + bounds[longest + 1]));
+        }
+        Some(Self {
+            levels,
+            switches,
+            duration,
+        })
+    }
+
     /// The level held at time t (the first level before the record starts).
     pub fn level_at(&self, t: f64) -> f64 {
         self.levels[self.switches.partition_point(|&s| s <= t)]
@@ -101,5 +136,16 @@ mod tests {
         assert!((back.levels[2] - p.levels[2]).abs() < 1e-9);
         assert_eq!(p.level_at(0.0), p.levels[0]);
         assert_eq!(p.level_at(0.49), p.levels[2]);
+    }
+
+    #[test]
+    fn a_held_input_becomes_a_profile_that_samples_back_to_it() {
+        let times: Vec<f64> = (1..=10).map(|i| i as f64 * 0.1).collect();
+        let values = [3.0, 3.0, 1.0, 1.0, 1.0, 1.0, -3.0, -3.0, -3.0, -3.0];
+        let p = Profile::from_held(&times, &values, 5, 1.0).unwrap();
+        assert_eq!((p.levels.len(), p.switches.len()), (5, 4));
+        assert!(p.switches.windows(2).all(|w| w[0] < w[1]));
+        assert_eq!(p.sampled(&times), values);
+        assert!(Profile::from_held(&times, &values, 2, 1.0).is_none());
     }
 }

@@ -1,6 +1,7 @@
 //! The search: Nelder–Mead (argmin) in the profile's free coordinates from several starts, run
-//! in parallel; each start is seeded on its own and the best is chosen by cost then by start
-//! index, so the result is the same whatever the thread count.
+//! in parallel; each start is seeded on its own and the caller chooses among the ends by cost
+//! (or a finer rating) then by start index, so the result is the same whatever the thread
+//! count.
 
 use argmin::core::{CostFunction, Executor, State};
 use argmin::solver::neldermead::NelderMead;
@@ -80,14 +81,14 @@ pub fn starts(settings: &SearchSettings, duration: f64, u_max: f64) -> Vec<Profi
     out
 }
 
-/// The best free coordinates found from each start, and their cost: (coordinates, cost) of
-/// the best start (the first among equals).
-pub fn minimise<F: Fn(&[f64]) -> f64 + Sync>(
+/// The best free coordinates found from each start and their cost, in the starts' order (the
+/// caller picks among them, the first among equals: the same whatever the thread count).
+pub fn minimise_each<F: Fn(&[f64]) -> f64 + Sync>(
     starts: &[Vec<f64>],
     iterations: u64,
     cost: &F,
-) -> (Vec<f64>, f64) {
-    let results: Vec<(Vec<f64>, f64)> = starts
+) -> Vec<(Vec<f64>, f64)> {
+    starts
         .par_iter()
         .map(|z0| {
             let mut simplex = vec![z0.clone()];
@@ -109,12 +110,5 @@ pub fn minimise<F: Fn(&[f64]) -> f64 + Sync>(
                 Err(_) => fallback,
             }
         })
-        .collect();
-    let mut best = results[0].clone();
-    for r in &results[1..] {
-        if r.1 < best.1 {
-            best = r.clone();
-        }
-    }
-    best
+        .collect()
 }
