@@ -1,9 +1,12 @@
 //! `motorcal design`: every designed input stays within the limits under every candidate, bad
 //! options get one clear error and write nothing, and a small design runs end to end.
 
+mod cli_support;
+
+use cli_support::{motorcal, one_error_line, scratch};
+
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 use motorcal::design::{
     self, Candidate, DesignSettings, Experiment, Limits, SearchSettings, design_problem,
@@ -21,35 +24,9 @@ fn fixture(name: &str) -> PathBuf {
         .join(name)
 }
 
-fn motorcal(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_motorcal"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .join(format!("motorcal-design-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
 /// The fixture's drive: 24 V, 300 A, 3000 rad/s.
 fn limits() -> Limits {
     "U=±24,I=±300,omega=±3000".parse().unwrap()
-}
-
-fn one_error_line(o: &Output, needles: &[&str]) {
-    assert!(!o.status.success(), "expected a failure");
-    let err = String::from_utf8_lossy(&o.stderr);
-    let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
-    assert_eq!(lines.len(), 1, "expected one error line, got: {err}");
-    assert!(!err.contains("panicked"), "{err}");
-    for n in needles {
-        assert!(err.contains(n), "'{err}' does not mention '{n}'");
-    }
 }
 
 /// The two tied candidates of the fixture at the diagnosis's estimates, on a short record.
@@ -143,7 +120,7 @@ fn the_same_seed_gives_the_same_design_whatever_the_thread_count() {
 
 #[test]
 fn a_small_design_runs_end_to_end() {
-    let dir = scratch("e2e");
+    let dir = scratch("design", "e2e");
     let out = dir.join("design");
     let o = motorcal(&[
         "design",
@@ -208,7 +185,7 @@ fn a_small_design_runs_end_to_end() {
 
 #[test]
 fn bad_options_get_one_clear_error_and_write_nothing() {
-    let dir = scratch("bad");
+    let dir = scratch("design", "bad");
     let out = dir.join("design");
     let model = fixture("motor.toml");
     let diagnosis = fixture("diagnosis.json");
@@ -327,7 +304,7 @@ fn without_a_recording_the_candidates_sit_at_the_model_values_and_a_zero_term_at
 
 #[test]
 fn design_fits_the_named_candidates_to_a_recording_when_no_diagnosis_is_given() {
-    let dir = scratch("fitted");
+    let dir = scratch("design", "fitted");
     let sim = dir.join("sim");
     let o = motorcal(&[
         "simulate",

@@ -4,9 +4,12 @@
 //! model is refused by name, and `simulate --input` plays a `t,I` file back into a recording —
 //! the loop design → simulate → diagnose closes.
 
+mod cli_support;
+
+use cli_support::{motorcal, one_error_line, scratch};
+
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 use motorcal::design::{
     self, Candidate, DesignSettings, Experiment, Limits, SearchSettings, design_problem,
@@ -22,34 +25,6 @@ fn model_path() -> PathBuf {
 }
 
 const LIMITS: &str = "I=±3,omega=±300";
-
-fn motorcal(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_motorcal"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!(
-        "motorcal-design-current-{}-{name}",
-        std::process::id()
-    ));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn one_error_line(o: &Output, needles: &[&str]) {
-    assert!(!o.status.success(), "expected a failure");
-    let err = String::from_utf8_lossy(&o.stderr);
-    let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
-    assert_eq!(lines.len(), 1, "expected one error line, got: {err}");
-    assert!(!err.contains("panicked"), "{err}");
-    for n in needles {
-        assert!(err.contains(n), "'{err}' does not mention '{n}'");
-    }
-}
 
 /// The largest |ω| of each candidate under a held current.
 fn peak_speeds(experiment: &Experiment, current: &[f64]) -> Vec<f64> {
@@ -69,7 +44,7 @@ fn peak_speeds(experiment: &Experiment, current: &[f64]) -> Vec<f64> {
 
 #[test]
 fn a_current_driven_design_writes_a_current_within_the_limits() {
-    let dir = scratch("limits");
+    let dir = scratch("design-current", "limits");
     let out = dir.join("design");
     let o = motorcal(&[
         "design",
@@ -307,7 +282,7 @@ fn on_hsm150_the_designed_current_beats_the_reversal_at_the_default_settings() {
 #[test]
 fn a_position_loop_model_is_refused_by_name() {
     let emps = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/emps/model.toml");
-    let out = scratch("position").join("design");
+    let out = scratch("design-current", "position").join("design");
     let o = motorcal(&[
         "design",
         "--model",
@@ -333,7 +308,7 @@ fn a_position_loop_model_is_refused_by_name() {
 
 #[test]
 fn simulate_plays_a_current_file_into_a_current_driven_recording() {
-    let dir = scratch("simulate");
+    let dir = scratch("design-current", "simulate");
     let input = dir.join("input.csv");
     let mut text = String::from("t,I\n");
     for i in 1..=200 {

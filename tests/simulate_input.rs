@@ -1,40 +1,15 @@
 //! `simulate --input FILE`: a `t,U` file drives the motor at its own times, the recording
 //! carries the U column, and a bad file gets one clear error and writes nothing.
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
+mod cli_support;
+
+use cli_support::{motorcal, one_error_line, scratch};
 
 use motorcal::io::{ChannelMap, read_model_file, read_recording, read_recording_for};
 
-fn motorcal(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_motorcal"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .join(format!("motorcal-siminput-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn one_error_line(o: &Output, needles: &[&str]) {
-    assert!(!o.status.success(), "expected a failure");
-    let err = String::from_utf8_lossy(&o.stderr);
-    let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
-    assert_eq!(lines.len(), 1, "expected one error line, got: {err}");
-    assert!(!err.contains("panicked"), "{err}");
-    for n in needles {
-        assert!(err.contains(n), "'{err}' does not mention '{n}'");
-    }
-}
-
 #[test]
 fn an_input_file_drives_the_recording_at_its_times() {
-    let dir = scratch("file");
+    let dir = scratch("siminput", "file");
     let input = dir.join("input.csv");
     let mut text = String::from("t,U\n");
     for i in 1..=200 {
@@ -64,7 +39,7 @@ fn an_input_file_drives_the_recording_at_its_times() {
 
 #[test]
 fn a_profile_name_still_works_and_a_bad_file_writes_nothing() {
-    let dir = scratch("bad");
+    let dir = scratch("siminput", "bad");
     let out = dir.join("sim");
     let o = motorcal(&[
         "simulate",
@@ -127,7 +102,7 @@ fn a_profile_name_still_works_and_a_bad_file_writes_nothing() {
 /// input is the commanded current of a `t,I` file; a profile has no current to run at.
 #[test]
 fn a_drive_base_truth_is_simulated_and_its_channels_named() {
-    let dir = scratch("drive-base");
+    let dir = scratch("siminput", "drive-base");
     let input = dir.join("current.csv");
     std::fs::write(&input, "t,I\n0.001,1\n0.002,1\n0.003,-1\n").unwrap();
     let truth = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/hsm150/model.toml");
