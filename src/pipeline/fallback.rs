@@ -45,12 +45,13 @@ pub(super) fn nuts_instead<P: Fittable>(
     // weighing draws, whose error converges slowly there, not as a shape: NUTS keeps it as its
     // metric. Above 0.7 it may be no metric to trust either (a banana's arms), but k̂ alone
     // cannot tell that from a Gaussian shape a little too narrow in one direction, which
-    // thins importance weights in twenty dimensions past use and costs NUTS nothing but a few
-    // leapfrog steps (the BM2 fit after a cogging law: R's posterior wider than the Laplace
-    // approximation's, k̂ 0.96, and on the Laplace metric NUTS passes its own diagnostics in
-    // a third of the windows' time; papers/beyond-library.md, session 12). So the Laplace metric is tried first
-    // everywhere, and the run's own R-hat, ESS and divergences decide whether Stan's windows,
-    // with their 1000-transition warm-up, are needed.
+    // thins importance weights in some twenty dimensions past use and costs NUTS nothing but
+    // a few leapfrog steps (the BM2 fit after a cogging law: R's posterior wider than the
+    // Laplace approximation's, k̂ 0.96, and on the Laplace metric NUTS passes its own
+    // diagnostics in about a third of the windows' time; papers/beyond-library.md, session
+    // 12). So the Laplace metric is tried first everywhere, and the run's own R-hat, ESS and
+    // divergences decide whether Stan's windows, with their 1000-transition warm-up, are
+    // needed.
     let metrics: &[MetricAdaptation] = if khat <= KHAT_UNRELIABLE {
         &[MetricAdaptation::Laplace]
     } else {
