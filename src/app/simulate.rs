@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use crate::io::{
     ModelFile, read_input_profile, read_model_file, write_model_file, write_recording_as,
 };
-use crate::motor::{MotorParameters, VoltageInput};
+use crate::motor::MotorParameters;
 pub use crate::study::InputProfile;
 
 /// The command line names the profiles as the model files and reports do.
@@ -19,7 +19,7 @@ impl clap::ValueEnum for InputProfile {
         Some(clap::builder::PossibleValue::new(self.name()).help(self.help()))
     }
 }
-use crate::synthetic::{DEFAULT_SEED, generate, sample_times};
+use crate::synthetic::{DEFAULT_SEED, sample_times};
 
 use super::AppError;
 
@@ -227,6 +227,10 @@ pub fn simulate(options: &SimulateOptions) -> Result<SimulateReport, AppError> {
         )));
     }
     let noise_sd = [options.noise_sd[0], options.noise_sd[1]];
+    let truth_error = |e: crate::error::Error| match e {
+        crate::error::Error::Settings(s) => AppError::Usage(format!("--truth: {}", s.message)),
+        e => AppError::from(e),
+    };
     let (recording, data) = match &options.input {
         InputSource::File(path) => {
             if options.samples.is_some() || options.t_end.is_some() {
@@ -236,12 +240,6 @@ pub fn simulate(options: &SimulateOptions) -> Result<SimulateReport, AppError> {
                     path.display()
                 )));
             }
-            let truth_error = |e: crate::error::Error| match e {
-                crate::error::Error::Settings(s) => {
-                    AppError::Usage(format!("--truth: {}", s.message))
-                }
-                e => AppError::from(e),
-            };
             let column = crate::study::input_column(truth_file.base).map_err(truth_error)?;
             let profile = read_input_profile(path, column)?;
             crate::study::held_input_record(
@@ -277,17 +275,15 @@ pub fn simulate(options: &SimulateOptions) -> Result<SimulateReport, AppError> {
             }
             let times = sample_times(t_end, samples);
             let input = profile.voltage(truth_file.motor.voltage, &times);
-            let model = truth_file
-                .model(input.clone())
-                .map_err(|e| AppError::Usage(format!("--truth: {e}")))?;
-            let data = generate(&model, &times, &noise_sd, options.seed)
-                .map_err(|e| AppError::Numerical(e.to_string()))?;
-            let voltage = match input {
-                VoltageInput::Held { values, .. } => Some(values),
-                VoltageInput::Constant => None,
-            };
-            let recording = crate::study::recording_from(&data, "motorcal simulate", voltage);
-            (recording, data)
+            crate::study::voltage_record(
+                &truth_file,
+                &times,
+                input,
+                &noise_sd,
+                options.seed,
+                "motorcal simulate",
+            )
+            .map_err(truth_error)?
         }
     };
     let report = SimulateReport {
