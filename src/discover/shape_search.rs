@@ -134,7 +134,8 @@ fn gain_left(tried: &[(f64, f64)], lower: f64, upper: f64) -> f64 {
     // A shape tried twice is one point (its better fit): a chord needs two shapes.
     points.dedup_by(|later, first| later.0 == first.0);
     let n = points.len();
-    if n < 2 {
+    // A score that is no number bounds nothing (f64::max would pass over it).
+    if n < 2 || points.iter().any(|p| !p.1.is_finite()) {
         return f64::INFINITY;
     }
     let best = points.iter().map(|p| p.1).fold(f64::NEG_INFINITY, f64::max);
@@ -264,6 +265,7 @@ mod tests {
         }
         // And it is finite once three shapes are tried, zero where the peak is an end's.
         assert!(gain_left(&[(0.5, 0.0)], 0.0, 1.0).is_infinite());
+        assert!(gain_left(&[(0.0, 0.0), (0.5, f64::NAN), (1.0, -2.0)], 0.0, 1.0).is_infinite());
         assert_eq!(
             gain_left(&[(0.0, 0.0), (0.5, -1.0), (1.0, -2.0)], 0.0, 1.0),
             0.0
