@@ -375,3 +375,83 @@ fn simulate_plays_a_current_file_into_a_current_driven_recording() {
     one_error_line(&run("step"), &["--input step", "current_driven", "t,I"]);
     assert!(!bad.exists());
 }
+
+/// On a current-driven drive with J calibrated, viscous friction is the torque constant with J
+/// rescaled (dω/dt = a·I − b·ω either way): a tie that no experiment parts. `diagnose` notes it
+/// with the experiment a drive tries — its record run the other way — not a voltage's reversal
+/// or step, which a drive is never given.
+#[test]
+fn on_a_drive_a_tie_no_experiment_parts_is_noted_with_the_drive_s_experiment() {
+    let dir = scratch("design-current", "tie-note");
+    let truth = dir.join("truth.toml");
+    let fixture = std::fs::read_to_string(model_path()).unwrap();
+    std::fs::write(
+        &truth,
+        fixture.replace(
+            "[drive]",
+            "[terms.viscous_friction]\nDd = 1.0e-4\n\n[drive]",
+        ),
+    )
+    .unwrap();
+    // Three current levels, none reversing: 0.5 s at 1 kHz.
+    let mut input = String::from("t,I\n");
+    for i in 1..=500 {
+        let level = [2.0, 0.5, 1.5][(i - 1) / 167];
+        input.push_str(&format!("{:.3},{level}\n", i as f64 / 1000.0));
+    }
+    std::fs::write(dir.join("input.csv"), input).unwrap();
+    let o = motorcal(&[
+        "simulate",
+        "--truth",
+        truth.to_str().unwrap(),
+        "--nominal",
+        model_path().to_str().unwrap(),
+        "--input",
+        dir.join("input.csv").to_str().unwrap(),
+        "--noise-sd",
+        "0",
+        "1",
+        "--seed",
+        "3",
+        "--out",
+        dir.join("record").to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let report = dir.join("report.json");
+    let o = motorcal(&[
+        "diagnose",
+        "--quiet",
+        "--rank-only",
+        "--data",
+        dir.join("record/recording.csv").to_str().unwrap(),
+        "--model",
+        model_path().to_str().unwrap(),
+        "--candidates",
+        "viscous_friction,torque_constant",
+        "--json",
+        report.to_str().unwrap(),
+        "--out",
+        dir.join("diagnosed").to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(report).unwrap()).unwrap();
+    let notes: Vec<&str> = report["notes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|n| n.as_str())
+        .filter(|n| n.contains("fit this recording equally well"))
+        .collect();
+    assert_eq!(notes.len(), 1, "{notes:?}");
+    assert!(
+        notes[0].contains("the record run the other way") && !notes[0].contains("step input"),
+        "{}",
+        notes[0]
+    );
+    assert!(
+        report["ties"].as_array().unwrap().is_empty(),
+        "{}",
+        report["ties"]
+    );
+}

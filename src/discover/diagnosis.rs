@@ -325,9 +325,17 @@ pub fn assemble(
                     ties.push(name.clone());
                     tie_experiments.insert(name.clone(), format!("{input:?}").to_lowercase());
                 }
+                // Say which experiment was tried: a drive's is its record run the other way,
+                // which cannot part two laws that differ only within one record's reversal
+                // (viscous and direction-dependent friction).
                 None => notes.push(format!(
-                    "{selected} and {name} fit this recording equally well and no reversal or \
-                     step input would separate them either"
+                    "{selected} and {name} fit this recording equally well and {} would not \
+                     separate them either",
+                    if problem.model.base.is_drive() {
+                        "the record run the other way"
+                    } else {
+                        "a reversal or a step input"
+                    }
                 )),
             }
         }
