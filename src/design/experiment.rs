@@ -273,21 +273,21 @@ impl Candidate {
 }
 
 impl Experiment {
-    /// What the candidates are driven by (all share the user's base).
-    pub fn commanded(&self) -> Result<Commanded, Error> {
-        let base = self
-            .candidates
+    /// The base the candidates share: the user's model's.
+    fn base(&self) -> Base {
+        self.candidates
             .first()
-            .map_or(Base::VoltageDriven, |c| c.problem.model.base);
-        Commanded::of(base)
+            .map_or(Base::VoltageDriven, |c| c.problem.model.base)
+    }
+
+    /// What the candidates are driven by.
+    pub fn commanded(&self) -> Result<Commanded, Error> {
+        Commanded::of(self.base())
     }
 
     /// The channels the candidates measure, in the order of `noise_sd`.
     pub fn channels(&self) -> &'static [&'static str] {
-        self.candidates
-            .first()
-            .map_or(Base::VoltageDriven, |c| c.problem.model.base)
-            .channels()
+        self.base().channels()
     }
 
     /// Observed values of one record: the N of a score's ½·d·ln N.
