@@ -7,8 +7,7 @@
 //! it. The input separates them when the selected one then leads by more than the threshold.
 
 use crate::error::Error;
-use crate::study::{InputProfile, Problem, recording_from};
-use crate::synthetic::generate;
+use crate::study::{InputProfile, Problem, voltage_record};
 
 use super::candidate::{Candidate, fit_candidate};
 
@@ -30,17 +29,10 @@ pub fn separating_input(
         return reversed_record(base, &truth, selected, other, noise_sd, threshold, seed);
     }
     for input in TIE_EXPERIMENTS {
-        let recording = &base.recordings[0];
-        let model_file = &truth.model;
-        let voltage = input.voltage(model_file.motor.voltage, &recording.time);
-        let model = model_file.model(voltage.clone()).map_err(Error::invalid)?;
-        let data = generate(&model, &recording.time, noise_sd, seed)
-            .map_err(|e| Error::Numerical(e.to_string()))?;
-        let values = match &voltage {
-            crate::motor::VoltageInput::Held { values, .. } => Some(values.clone()),
-            crate::motor::VoltageInput::Constant => None,
-        };
-        let synthetic = recording_from(&data, &format!("simulated {input:?} input"), values);
+        let times = &base.recordings[0].time;
+        let voltage = input.voltage(truth.model.motor.voltage, times);
+        let source = format!("simulated {input:?} input");
+        let (synthetic, _) = voltage_record(&truth.model, times, voltage, noise_sd, seed, &source)?;
         if separates(base, synthetic, selected, other, threshold)? {
             return Ok(Some(input));
         }

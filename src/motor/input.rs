@@ -27,6 +27,14 @@ impl VoltageInput {
         }
     }
 
+    /// The held series, or `None` for a constant input: what a record carries as its `U`.
+    pub fn held_values(&self) -> Option<&[f64]> {
+        match self {
+            VoltageInput::Constant => None,
+            VoltageInput::Held { values, .. } => Some(values),
+        }
+    }
+
     /// Times at which the held value actually changes (not every sample: stopping the
     /// integrator there would cost a restart for nothing).
     pub fn breakpoints(&self) -> Vec<f64> {

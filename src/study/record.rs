@@ -67,21 +67,18 @@ pub fn held_input_record(
 
 /// The record `file`'s voltage-driven model makes under `input` (a held voltage, or constant at
 /// the model's U) at `times`, with noise σ = `noise_sd` (σ_I, σ_ω); a held voltage is recorded
-/// as the `U` column.
+/// as the `U` column. What `simulate` writes, and the experiment a tie is checked on.
 pub fn voltage_record(
     file: &ModelFile,
     times: &[f64],
     input: VoltageInput,
-    noise_sd: &[f64; 2],
+    noise_sd: &[f64],
     seed: u64,
     source: &str,
 ) -> Result<(Recording, SyntheticData), Error> {
-    let model = file.model(input.clone()).map_err(Error::invalid)?;
+    let voltage = input.held_values().map(<[f64]>::to_vec);
+    let model = file.model(input).map_err(Error::invalid)?;
     let data =
         generate(&model, times, noise_sd, seed).map_err(|e| Error::Numerical(e.to_string()))?;
-    let voltage = match input {
-        VoltageInput::Held { values, .. } => Some(values),
-        VoltageInput::Constant => None,
-    };
     Ok((recording_from(&data, source, voltage), data))
 }

@@ -87,10 +87,7 @@ pub struct Answer {
 }
 
 fn nominal_problem(input: &VoltageInput, times: &[f64]) -> Problem {
-    let voltage = match input {
-        VoltageInput::Held { values, .. } => Some(values.clone()),
-        VoltageInput::Constant => None,
-    };
+    let voltage = input.held_values().map(<[f64]>::to_vec);
     Problem {
         label: "case".into(),
         recordings: vec![Recording {
@@ -506,10 +503,7 @@ fn assemble_case(
             ("I".into(), measured[0].clone()),
             ("omega".into(), measured[1].clone()),
         ],
-        voltage: match voltage {
-            VoltageInput::Held { values, .. } => Some(values.clone()),
-            VoltageInput::Constant => None,
-        },
+        voltage: voltage.held_values().map(<[f64]>::to_vec),
         inputs: Vec::new(),
     };
     let mut params = BTreeMap::new();
