@@ -41,7 +41,7 @@ PY
   done
 done
 python3 - "$W" <<'PY'
-import json, sys, glob, os
+import csv, json, sys, glob, os
 w = sys.argv[1]
 print("| truth | rival | pair: truth selected (of 20) | truth's lead over rival, min / median (nats) | whole library: truth selected | truth selected or tied | whole library's selections |")
 print("|---|---|---|---|---|---|---|")
@@ -49,7 +49,7 @@ for pair in (("coulomb_friction", "load_torque"), ("viscous_friction", "quadrati
     for truth in pair:
         rival = pair[1] if truth == pair[0] else pair[0]
         runs = sorted(glob.glob(f"{w}/{pair[0]}/records/{truth}/*/pair.json"))
-        leads, pair_hits, whole_hits, tied_hits, picks = [], 0, 0, 0, {}
+        leads, pair_hits, whole_hits, tied_hits, picks, behind = [], 0, 0, 0, {}, []
         for p in runs:
             r = json.load(open(p))
             score = {e["effect"]: e["score"] for e in r["ranking"]}
@@ -57,6 +57,9 @@ for pair in (("coulomb_friction", "load_torque"), ("viscous_friction", "quadrati
             pair_hits += r["selected"] == truth
             q = json.load(open(os.path.join(os.path.dirname(p), "whole.json")))
             whole_hits += q["selected"] == truth
+            whole = {e["effect"]: e["score"] for e in q["ranking"]}
+            if q["selected"] != truth:
+                behind.append((max(whole.values()), whole.get(truth, float("nan"))))
             tied_hits += q["selected"] == truth or truth in (q.get("ties") or [])
             name = str(q["selected"]) + ("" if not q.get("ties") else " (ties " + ", ".join(q["ties"]) + ")")
             picks[name] = picks.get(name, 0) + 1
@@ -64,4 +67,16 @@ for pair in (("coulomb_friction", "load_torque"), ("viscous_friction", "quadrati
         med = leads[len(leads) // 2] if leads else float("nan")
         pk = "; ".join(f"{k} {v}" for k, v in sorted(picks.items(), key=lambda kv: -kv[1]))
         print(f"| {truth} | {rival} | {pair_hits} of {len(runs)} | {leads[0]:.1f} / {med:.1f} | {whole_hits} | {tied_hits} | {pk} |")
+        # Where the whole library put another term on top: how far below it the truth scored.
+        below = [top - own for top, own in behind]
+        if below:
+            print(f"|   | where {truth} was not on top ({len(below)}): it scored at most {max(below):.3f} nats below the top |")
+# The speeds each designed record reaches (the noise included): whether a design reverses.
+for pair in (("coulomb_friction", "load_torque"), ("viscous_friction", "quadratic_drag")):
+    lows, highs = [], []
+    for p in glob.glob(f"{w}/{pair[0]}/records/*/*/recording.csv"):
+        rows = list(csv.DictReader(open(p)))
+        speeds = [float(r["omega"]) for r in rows]
+        lows.append(min(speeds)); highs.append(max(speeds))
+    print(f"{pair[0]}'s design: omega from {min(lows):.1f} to {max(highs):.1f} rad/s over its {len(lows)} records")
 PY
