@@ -286,3 +286,86 @@ fn a_sensor_lag_names_its_channel_and_a_bad_one_is_one_error() {
         );
     }
 }
+
+/// The noise-free channels and what the solve cost, at the fits' default tolerances.
+fn simulate_counted(
+    terms: Vec<ActiveTerm>,
+    input: &VoltageInput,
+    times: &[f64],
+) -> (Vec<f64>, usize) {
+    let model = MotorModel::with_terms(MotorParameters::default(), input.clone(), terms).unwrap();
+    let fm = ForwardModel::new(
+        model,
+        times.to_vec(),
+        &[] as &[&str],
+        SolverSettings::default(),
+    )
+    .unwrap();
+    let mut out = vec![0.0; fm.n_outputs()];
+    let stats = fm.simulate(&[], &mut out).unwrap();
+    (out, stats.accepted_steps + stats.rejected_steps)
+}
+
+/// A filter of a few µs would hold an explicit integrator to steps of a few µs (tens of
+/// thousands per 0.5-s solve, the cap at 50 000); advanced in closed form it costs the solve
+/// no step, and it reads its channel as a first-order lag does: τ late, to O(τ²·ẍ).
+/// (Before the closed form, the 5-µs lags here took over 20 000 steps per solve.)
+#[test]
+fn a_lag_of_microseconds_costs_the_solve_no_step_and_reads_its_channel_tau_late() {
+    let times = grid(1e-3, 0.5);
+    let input = reversal();
+    let (truth, plain_steps) = simulate_counted(Vec::new(), &input, &times);
+    let m = times.len();
+    for (channel, tau) in [(0usize, 5e-6), (1, 5e-6), (0, 3e-5)] {
+        let (lagged, steps) = simulate_counted(
+            vec![active("sensor_lag", Some(&[channel as f64]), &[tau])],
+            &input,
+            &times,
+        );
+        println!("τ = {tau} on channel {channel}: {steps} steps, {plain_steps} without the lag");
+        assert!(
+            steps <= plain_steps + plain_steps / 4,
+            "τ = {tau} on channel {channel}: {steps} steps against {plain_steps} without the lag"
+        );
+        // x(t − τ) from the motor without the lag, sampled τ earlier.
+        let earlier: Vec<f64> = times.iter().map(|t| t - tau).collect();
+        let (late, _) = simulate_counted(Vec::new(), &input, &earlier);
+        let x = &truth[channel * m..(channel + 1) * m];
+        let y = &lagged[channel * m..(channel + 1) * m];
+        let x_late = &late[channel * m..(channel + 1) * m];
+        let scale = peak(x);
+        let mut worst = 0.0f64;
+        let mut shift = 0.0f64;
+        for i in 0..m {
+            // Within a few electrical time constants of a step ẍ is large and the lag is not a
+            // pure shift there.
+            if [0.0, 0.1, 0.3].iter().any(|s| (times[i] - s).abs() < 5e-3) {
+                continue;
+            }
+            worst = worst.max((y[i] - x_late[i]).abs());
+            shift = shift.max((x[i] - x_late[i]).abs());
+        }
+        // A lag and a delay part at τ²·ẍ/2: within a tenth of the shift itself here.
+        assert!(
+            shift > 1e-6 * scale && worst <= 1e-6 * scale + 0.1 * shift,
+            "τ = {tau} on channel {channel}: y − x(t − τ) reaches {worst:.3e} (x − x(t − τ) {shift:.3e})"
+        );
+    }
+}
+
+/// ∂G/∂τ of the lag from a few µs (where the closed form's series and recurrence branches meet
+/// within a step) to a slow filter, on either channel.
+#[test]
+fn the_lag_s_sensitivity_holds_from_microseconds_to_a_slow_filter() {
+    for channel in [0.0, 1.0] {
+        for tau in [5e-6, 4e-4, 3e-2] {
+            let model = MotorModel::with_terms(
+                MotorParameters::default(),
+                reversal(),
+                vec![active("sensor_lag", Some(&[channel]), &[tau])],
+            )
+            .unwrap();
+            check_column(model, "sensor_lag.tau", tau, 1e-5 * tau, true);
+        }
+    }
+}

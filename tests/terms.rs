@@ -59,9 +59,19 @@ fn term(name: &str) -> ActiveTerm {
     }
 }
 
-/// Checks every column of ∂G/∂θ against central differences of G.
+/// Checks every column of ∂G/∂θ against central differences of G, at the data generator's
+/// tolerances.
 fn assert_sensitivities_match_finite_differences(model: MotorModel, names: &[String]) {
-    let solver = SolverSettings::for_data_generation();
+    assert_sensitivities_match_at(model, names, SolverSettings::for_data_generation(), 2e-4);
+}
+
+/// The same at `solver`'s tolerances, each column within `share` of its own peak.
+fn assert_sensitivities_match_at(
+    model: MotorModel,
+    names: &[String],
+    solver: SolverSettings,
+    share: f64,
+) {
     let fm = ForwardModel::new(model, times(), names, solver).unwrap();
     let theta = fm.nominal_calibrated();
     let n = fm.n_outputs();
@@ -73,7 +83,7 @@ fn assert_sensitivities_match_finite_differences(model: MotorModel, names: &[Str
     fm.simulate(&theta, &mut plain).unwrap();
     for (a, b) in plain.iter().zip(&out) {
         assert!(
-            (a - b).abs() <= 1e-9 * (1.0 + a.abs()),
+            (a - b).abs() <= 10.0 * solver.rtol * (1.0 + a.abs()),
             "the dual solve's values are the f64 solve's: {a} vs {b}"
         );
     }
@@ -92,7 +102,7 @@ fn assert_sensitivities_match_finite_differences(model: MotorModel, names: &[Str
         for i in 0..n {
             let fd = (gp[i] - gm[i]) / (2.0 * h);
             assert!(
-                (fd - column[i]).abs() <= 2e-4 * scale,
+                (fd - column[i]).abs() <= share * scale,
                 "{name}, output {i}: dual {} vs finite difference {fd} (scale {scale})",
                 column[i]
             );
@@ -118,6 +128,31 @@ fn every_terms_sensitivities_match_finite_differences() {
                 .unwrap();
         let names = calibrated(&model);
         assert_sensitivities_match_finite_differences(model, &names);
+    }
+}
+
+/// Beside a lag on the speed, at the tolerances every fit runs at: the derivatives a
+/// diagnosis's step screen, L-BFGS and Laplace evidence use. While the lag's state was
+/// integrated with the others (to 2026-12-01) this failed, on coulomb_friction.T_c first (0.1%
+/// of its column's scale off), where every term passes without the lag; at the armature
+/// reaction's absent κ the current's sensitivity came out 64× its finite difference (1.7e6
+/// against 2.65e4), and the step screen beside a lag saw no gain where the fit then found 19
+/// nats (bearing_defect-690003).
+#[test]
+fn beside_a_lag_every_terms_sensitivities_hold_at_the_fits_tolerances() {
+    for name in Term::NAMES.iter().filter(|&&n| n != "sensor_lag") {
+        let lag = ActiveTerm {
+            term: Term::from_name("sensor_lag", &[1.0]).unwrap().unwrap(),
+            values: vec![0.0142],
+        };
+        let model = MotorModel::with_terms(
+            MotorParameters::default(),
+            reversal(),
+            vec![lag, term(name)],
+        )
+        .unwrap();
+        let names = calibrated(&model);
+        assert_sensitivities_match_at(model, &names, SolverSettings::default(), 1e-3);
     }
 }
 

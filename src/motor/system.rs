@@ -3,7 +3,7 @@
 
 use super::balance::{Site, torque_balance, voltage_balance};
 use super::{Coefficients, InputSteps, MotorModel, MotorParam, Scalar, VoltageInput};
-use crate::ode::OdeSystem;
+use crate::ode::{ExactLag, OdeSystem};
 
 impl MotorModel {
     /// The ODE system at one parameter vector, ready for the integrator. `segments` is
@@ -108,6 +108,21 @@ impl<D: Scalar> OdeSystem<D> for MotorSystem<'_, D> {
     fn rhs(&self, t: f64, segment: usize, y: &[D], dy: &mut [D]) {
         let voltage = self.voltage(segment);
         self.with_terms(t, segment, voltage, y, dy);
+    }
+
+    fn exact_lags(&self) -> Vec<ExactLag<D>> {
+        let model = self.model;
+        (model.terms.iter().enumerate())
+            .filter_map(|(k, active)| {
+                let params = &self.p[model.param_offsets[k]..model.param_offsets[k + 1]];
+                let (source, tau) = active.term.exact_lag(params)?;
+                Some(ExactLag {
+                    state: model.state_offsets[k],
+                    source,
+                    tau,
+                })
+            })
+            .collect()
     }
 }
 

@@ -3,6 +3,7 @@
 
 use num_dual::DualNum;
 
+use super::exact_lag::{lag_at, monomials};
 use super::{OdeError, OdeSystem, SolverSettings, SolverStats};
 
 const C2: f64 = 1.0 / 5.0;
@@ -114,6 +115,7 @@ where
     };
 
     let breakpoints = system.breakpoints();
+    let lags = system.exact_lags();
     let mut y: Vec<D> = y0.to_vec();
     let mut s = Stages::new(n);
     let mut next_out = 0;
@@ -187,15 +189,22 @@ where
                 }
                 stats.accepted_steps += 1;
                 dense_coefficients(n, h_step, &y, &mut s);
+                // Each exact lag's source over the step, as a polynomial in θ.
+                let lag_polys: Vec<[D; 5]> = lags
+                    .iter()
+                    .map(|l| monomials(std::array::from_fn(|j| s.cont[j][l.source])))
+                    .collect();
                 while next_out < t_out.len() && t_out[next_out] <= t_new {
                     let theta = ((t_out[next_out] - t) / h_step).clamp(0.0, 1.0);
-                    interpolate(
-                        n,
-                        theta,
-                        &s.cont,
-                        &mut out[next_out * n..(next_out + 1) * n],
-                    );
+                    let row = &mut out[next_out * n..(next_out + 1) * n];
+                    interpolate(n, theta, &s.cont, row);
+                    for (l, poly) in lags.iter().zip(&lag_polys) {
+                        row[l.state] = lag_at(y[l.state], l.tau, h_step, theta, poly);
+                    }
                     next_out += 1;
+                }
+                for (l, poly) in lags.iter().zip(&lag_polys) {
+                    s.y_new[l.state] = lag_at(y[l.state], l.tau, h_step, 1.0, poly);
                 }
                 std::mem::swap(&mut y, &mut s.y_new);
                 s.k.swap(0, 6); // first same as last

@@ -4,9 +4,11 @@
 //! run take the same steps and the dual part is the exact derivative of the numerical solution.
 
 mod dopri5;
+mod exact_lag;
 mod sampled;
 
 pub use dopri5::{RHS_PER_STEP, solve};
+pub use exact_lag::ExactLag;
 pub use sampled::{HeldInputSystem, solve_sampled};
 
 use serde::{Deserialize, Serialize};
@@ -22,6 +24,13 @@ pub trait OdeSystem<D> {
     /// A discrete event applied to the state when the integrator reaches breakpoint `index`
     /// (e.g. a sampled controller); none by default.
     fn at_breakpoint(&self, _index: usize, _y: &mut [D]) {}
+    /// States that lag another through τ·ẏ = x − y and feed nothing back (a sensor's filter):
+    /// the integrator advances them in closed form from x's dense output over each step, so
+    /// that a lag far faster than the dynamics does not bound the step. Their right-hand side
+    /// must stay zero. None by default.
+    fn exact_lags(&self) -> Vec<ExactLag<D>> {
+        Vec::new()
+    }
 }
 
 /// Tolerances and limits of the integrator.

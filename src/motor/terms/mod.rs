@@ -110,6 +110,12 @@ pub trait PhysicsTerm: Sized + Clone + std::fmt::Debug + PartialEq {
     fn breakpoints(&self, _params: &[f64]) -> Vec<f64> {
         Vec::new()
     }
+    /// For a term whose one state lags a base state and feeds nothing back: that base state's
+    /// index and the time constant, which the integrator then uses to advance the state in
+    /// closed form ([`crate::ode::OdeSystem::exact_lags`]); `derivatives` leaves it at zero.
+    fn exact_lag<D: Scalar>(&self, _params: &[D]) -> Option<(usize, D)> {
+        None
+    }
 }
 
 /// tanh that stays finite for dual numbers: num-dual computes it as sinh/cosh, which is ∞/∞
@@ -312,6 +318,10 @@ macro_rules! terms {
 
             pub fn breakpoints(&self, params: &[f64]) -> Vec<f64> {
                 match self { $(Term::$variant(t) => t.breakpoints(params)),* }
+            }
+
+            pub fn exact_lag<D: Scalar>(&self, params: &[D]) -> Option<(usize, D)> {
+                match self { $(Term::$variant(t) => t.exact_lag(params)),* }
             }
         }
     };

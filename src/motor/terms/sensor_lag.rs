@@ -1,7 +1,8 @@
 //! A sensor that lags: the measured channel (I or ω, the setting `channel`) is its true value
 //! through a first-order filter of time constant τ, τ·dy/dt = x − y, with y a new state that
 //! starts settled on the channel (y(0) = x(0)). τ = 0 is the sensor without lag: y is then not
-//! integrated and the channel is measured as it is.
+//! advanced and the channel is measured as it is. y feeds nothing back, so the integrator
+//! advances it in closed form from the channel's dense output ([`crate::ode::ExactLag`]).
 
 use super::{
     Balance, Magnitudes, PRIOR_SHARE, PhysicsTerm, Sample, Site, TermParam, TermSetting, TermState,
@@ -69,16 +70,15 @@ impl PhysicsTerm for SensorLag {
         states[0] = base[self.channel];
     }
 
-    fn derivatives<D: Scalar>(&self, site: &Site<D>, _: &Balance<D>, d: &mut [D]) {
-        let tau = site.params[0];
-        if tau.re() > 0.0 {
-            let x = if self.channel == 0 {
-                site.current
-            } else {
-                site.speed
-            };
-            d[0] = (x - site.states[0]) / tau;
-        }
+    /// y is advanced in closed form by the integrator (`exact_lag`): an explicit step would
+    /// have to stay within a few τ, and a fit walking τ toward zero would take tens of
+    /// thousands of steps per solve. So its derivative here stays zero.
+    fn derivatives<D: Scalar>(&self, _: &Site<D>, _: &Balance<D>, d: &mut [D]) {
+        d[0] = D::from(0.0);
+    }
+
+    fn exact_lag<D: Scalar>(&self, params: &[D]) -> Option<(usize, D)> {
+        (params[0].re() > 0.0).then_some((self.channel, params[0]))
     }
 
     fn measure<D: Scalar>(&self, params: &[D], states: &[D], _: Sample<D>, channels: &mut [D]) {
