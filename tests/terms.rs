@@ -131,6 +131,23 @@ fn every_terms_sensitivities_match_finite_differences() {
     }
 }
 
+/// Each term alone and all of them together, at the tolerances every fit runs at (rtol 1e-8):
+/// the dual parts follow the steps the real parts chose, so they are checked there too.
+#[test]
+fn every_terms_sensitivities_hold_at_the_fits_tolerances() {
+    for name in Term::NAMES {
+        let model =
+            MotorModel::with_terms(MotorParameters::default(), reversal(), vec![term(name)])
+                .unwrap();
+        let names = calibrated(&model);
+        assert_sensitivities_match_at(model, &names, SolverSettings::default(), 1e-3);
+    }
+    let terms: Vec<ActiveTerm> = Term::NAMES.iter().map(|n| term(n)).collect();
+    let model = MotorModel::with_terms(MotorParameters::default(), reversal(), terms).unwrap();
+    let names = calibrated(&model);
+    assert_sensitivities_match_at(model, &names, SolverSettings::default(), 1e-3);
+}
+
 /// Beside a lag on the speed, at the tolerances every fit runs at: the derivatives a
 /// diagnosis's step screen, L-BFGS and Laplace evidence use. While the lag's state was
 /// integrated with the others (to 2026-12-01) this failed, on coulomb_friction.T_c first (0.1%
