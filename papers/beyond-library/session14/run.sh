@@ -37,3 +37,10 @@ for T in /tmp/base .; do cp $HERE/probe_sensitivities.rs $T/tests/
   (cd $T && echo "== $(git log --oneline -1 | cut -c1-7)" && cargo test --release --test probe_sensitivities -- --nocapture 2>&1 | grep -E "params|test result")
   rm $T/tests/probe_sensitivities.rs
 done > $HERE/probe_sensitivities.txt
+# 4. The plain model (no term: the integrator's hot path), the whole fit a user waits for, five
+#    runs of each build alternating, quiet; then the chains compared byte for byte.
+C=tests/fixtures/cases/coulomb_friction
+for i in 1 2 3 4 5; do for b in base new; do eval BIN=\$BIN_$b; s=$(date +%s.%N)
+  $BIN fit --data $C/recording.csv --model $C/motor.toml --quiet --sampler nuts-dense --k 9 --seed 1 --force --out /tmp/fitab-$b > /dev/null 2>&1
+  e=$(date +%s.%N); echo "$b $(echo "$e - $s" | bc)"; done; done > $HERE/fit-plain-model-ab.txt
+for k in 1 2 3 4; do cmp /tmp/fitab-base/fit-nuts-dense-chain$k.csv /tmp/fitab-new/fit-nuts-dense-chain$k.csv; done
