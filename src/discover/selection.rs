@@ -7,6 +7,7 @@ use rayon::prelude::*;
 use crate::error::Error;
 use crate::parameter::ParamId;
 use crate::study::Problem;
+use crate::study::frequency_grid::nyquist_over;
 
 use super::candidate::{Candidate, Starts, fit_candidate_started};
 use super::confirm::importance_evidence;
@@ -86,7 +87,7 @@ fn resolved_band(problem: &Problem) -> (f64, f64) {
         .fold(0.0, f64::max);
     let high = (problem.recordings.iter())
         .filter(|r| r.time.len() > 1)
-        .map(|r| 0.5 * (r.time.len() - 1) as f64 / span(&r.time))
+        .map(|r| nyquist_over(span(&r.time), r.time.len()))
         .fold(0.0, f64::max);
     (lowest_frequency_over(low), high)
 }
@@ -99,9 +100,9 @@ fn resolved_band(problem: &Problem) -> (f64, f64) {
 /// where it was selected), on 0.5-s records that show nothing below 4 Hz. Above the Nyquist
 /// frequency its ringing, sampled, is an alias: on bearing_defect-760018 (samples 0.998 ms
 /// apart, 1002 Hz) a coupling fitted at 995.7 Hz with ζ = 0.0008 rang at 6.3 Hz in the samples
-/// and ranked +81.9 nats as a slow ripple. Started from the verdict's oscillation search, it pays that search's
-/// look-elsewhere cost over the band between (`frequency_search_cost`). A fit outside the band
-/// names physics the record cannot have shown, so it is not ranked.
+/// and ranked +81.9 nats as a slow ripple. Started from the verdict's oscillation search, it
+/// pays that search's look-elsewhere cost over the band between (`frequency_search_cost`). A
+/// fit outside the band names physics the record cannot have shown, so it is not ranked.
 fn unresolved_resonance(problem: &Problem, fit: &Candidate) -> Option<f64> {
     let key = ParamId::of_term("compliant_coupling", "f_r").to_string();
     let (low, high) = resolved_band(problem);

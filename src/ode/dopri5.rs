@@ -116,6 +116,7 @@ where
 
     let breakpoints = system.breakpoints();
     let lags = system.exact_lags();
+    let mut lag_polys: Vec<[D; 5]> = Vec::with_capacity(lags.len());
     let mut y: Vec<D> = y0.to_vec();
     let mut s = Stages::new(n);
     let mut next_out = 0;
@@ -190,10 +191,10 @@ where
                 stats.accepted_steps += 1;
                 dense_coefficients(n, h_step, &y, &mut s);
                 // Each exact lag's source over the step, as a polynomial in θ.
-                let lag_polys: Vec<[D; 5]> = lags
-                    .iter()
-                    .map(|l| monomials(std::array::from_fn(|j| s.cont[j][l.source])))
-                    .collect();
+                lag_polys.clear();
+                lag_polys.extend(
+                    (lags.iter()).map(|l| monomials(std::array::from_fn(|j| s.cont[j][l.source]))),
+                );
                 while next_out < t_out.len() && t_out[next_out] <= t_new {
                     let theta = ((t_out[next_out] - t) / h_step).clamp(0.0, 1.0);
                     let row = &mut out[next_out * n..(next_out + 1) * n];

@@ -15,6 +15,13 @@ pub fn lowest_frequency_over(span: f64) -> f64 {
     2.0 / span
 }
 
+/// The Nyquist frequency of `n` samples evenly over `span` seconds: above it a sampled sinusoid
+/// is the alias of a slower one.
+pub fn nyquist_over(span: f64, n: usize) -> f64 {
+    let dt = span / (n - 1).max(1) as f64;
+    0.5 / dt
+}
+
 /// What a term whose frequency started at the best of a grid of `frequencies` points pays on
 /// top of its score's ½·ln N per parameter: the frequency's look-elsewhere cost, ln G, *in
 /// place of* its ½·ln N, as this search's sinusoid pays it (ln G for the frequency, ½·ln N for
@@ -38,8 +45,7 @@ pub fn searched_frequencies(span: f64, n: usize) -> usize {
 /// The frequency grid of a record of `n` samples over `span` seconds, its spacing and its
 /// lowest frequency.
 pub fn grid_over(span: f64, n: usize) -> (Vec<f64>, f64, f64) {
-    let dt = span / (n - 1).max(1) as f64;
-    let nyquist = 0.5 / dt;
+    let nyquist = nyquist_over(span, n);
     let f_min = lowest_frequency_over(span);
     let step = (1.0 / (OVERSAMPLING * span)).max((nyquist - f_min) / MAX_FREQUENCIES as f64);
     let grid = (0..)
