@@ -3,7 +3,8 @@
 //! none, or two) scaled so that the noise-free truth minus the best nominal model (R refitted
 //! by weighted least squares) peaks at a chosen multiple of the noise σ, 501 samples over
 //! 0.5 s with σ_I = 2 A and σ_ω = 10 rad/s. `--conceal` keeps that peak below 1.5σ and redraws a
-//! case until the oracle ([`oracle`]) finds the effect identifiable on the noise-free truth; an
+//! case until the oracle ([`oracle`]) finds the effect identifiable on the noise-free truth and
+//! on the noisy record (not for a tie: there, the noise-free truth's tie on its input); an
 //! effect that is not identifiable on the asked input after [`REDRAWS`] draws moves to a richer
 //! one (constant → step → reversal → square), recorded in `answer.json`.
 
@@ -23,10 +24,9 @@ use crate::ode::SolverSettings;
 use crate::parameter::{ParamId, Support};
 use crate::study::InputProfile;
 use crate::study::Problem;
-use crate::study::frequency_grid::{frequency_search_cost, searched_frequencies};
 use crate::synthetic::sample_times;
 
-use oracle::{NONE_MARGIN, RUNNER_UP_MARGIN, least_squares, least_squares_set};
+use oracle::{NONE_MARGIN, RUNNER_UP_MARGIN, least_squares};
 
 pub const NOISE_SD: [f64; 2] = [2.0, 10.0];
 pub const SAMPLES: usize = 501;
@@ -83,6 +83,11 @@ pub struct Answer {
     pub oracle_margin: Option<f64>,
     pub oracle_runner_up: Option<String>,
     pub oracle_margin_over_none: Option<f64>,
+    /// The same on the noisy record (a concealed effect's; absent otherwise), with the truth's
+    /// form refitted to it: a concealed case is made only where both lead by the margins.
+    pub oracle_margin_realized: Option<f64>,
+    pub oracle_runner_up_realized: Option<String>,
+    pub oracle_margin_over_none_realized: Option<f64>,
     pub attempts: usize,
 }
 
@@ -224,96 +229,6 @@ fn scale_effect(
     Ok(sign * (lo * hi).sqrt())
 }
 
-/// The oracle's expected-score margins of a truth with `effects`: (lead over the best
-/// alternative, its name, lead over none). The alternatives of one effect are every other
-/// one-effect model and none; of two effects, each of the two alone and every pair that swaps
-/// one of them for another term.
-fn oracle_margins(
-    base: &Problem,
-    truth: &[f64],
-    effects: &[String],
-) -> Result<(f64, String, f64), Error> {
-    let n = (2 * SAMPLES) as f64;
-    // A resonance's frequency no one knows is searched for: `diagnose` starts the coupling at
-    // the best of G frequencies and charges it ln G in place of its ½·ln N, and so does the
-    // oracle, so that a case it makes is one `diagnose`'s own score can find.
-    let searched = frequency_search_cost(searched_frequencies(DURATION, SAMPLES), 2 * SAMPLES);
-    let score_set = |added: &[String], set: &[Term]| -> Result<f64, Error> {
-        let problem = base.with_terms(added)?;
-        let d = problem.calibrated_names()?.len() as f64 - 1.0;
-        let (ss, _) = least_squares_set(base, added, set, truth, &NOISE_SD)?;
-        let search = if added.iter().any(|a| a == "compliant_coupling") {
-            searched
-        } else {
-            0.0
-        };
-        Ok(-0.5 * ss - 0.5 * d * n.ln() - search)
-    };
-    let score = |added: &[String]| score_set(added, &[]);
-    let own = score(effects)?;
-    let none = score(&[])?;
-    let mut alternatives: Vec<Vec<String>> = Vec::new();
-    let others: Vec<String> = Term::NAMES
-        .iter()
-        .filter(|t| !effects.iter().any(|e| e == *t))
-        .map(|t| t.to_string())
-        .collect();
-    if effects.len() == 1 {
-        alternatives.extend(others.iter().map(|o| vec![o.clone()]));
-    } else {
-        for (i, kept) in effects.iter().enumerate() {
-            alternatives.push(vec![kept.clone()]);
-            for o in &others {
-                let mut pair = effects.to_vec();
-                pair[1 - i] = o.clone();
-                alternatives.push(pair);
-            }
-        }
-    }
-    let mut runner_up = ("none".to_string(), none);
-    for alt in alternatives {
-        let s = score(&alt)?;
-        if s > runner_up.1 {
-            runner_up = (alt.join("+"), s);
-        }
-        // A term with a choice among channels is an alternative on each of them: `diagnose`
-        // fits a lag on whichever channel the residual points to.
-        for set in choice_variants(&alt) {
-            let s = score_set(&alt, std::slice::from_ref(&set))?;
-            if s > runner_up.1 {
-                runner_up = (format!("{} ({:?})", alt.join("+"), set), s);
-            }
-        }
-    }
-    Ok((own - runner_up.1, runner_up.0, own - none))
-}
-
-/// The terms among `names` with a setting that chooses (a channel), at each choice other than
-/// the default.
-fn choice_variants(names: &[String]) -> Vec<Term> {
-    let mut out = Vec::new();
-    for name in names {
-        let (Some((_, settings)), Some(term)) = (Term::declarations(name), Term::named(name))
-        else {
-            continue;
-        };
-        let defaults = term.settings();
-        for (k, s) in settings.iter().enumerate() {
-            for index in 0..s.choices.len() {
-                if index as f64 == defaults[k] {
-                    continue;
-                }
-                let mut values = defaults.clone();
-                values[k] = index as f64;
-                if let Some(Ok(t)) = Term::from_name(name, &values) {
-                    out.push(t);
-                }
-            }
-        }
-    }
-    out
-}
-
 pub fn make_case(options: &CaseOptions) -> Result<Case, Error> {
     let effects: Vec<String> = options
         .effects
@@ -372,6 +287,8 @@ pub fn make_case(options: &CaseOptions) -> Result<Case, Error> {
     } else {
         ladder.len()
     };
+    // The noise is the seed's alone, the same on every draw of the effect.
+    let noise = noise_draw(options.seed);
     let mut attempts = 0;
     for (rung, &input) in ladder.iter().enumerate().take(last).skip(first) {
         let voltage = input.voltage(24.0, &times);
@@ -421,35 +338,45 @@ pub fn make_case(options: &CaseOptions) -> Result<Case, Error> {
             if options.conceal && effects.len() == 1 && peak[0].max(peak[1]) >= CONCEALED_MAX {
                 continue;
             }
-            let (margin, runner_up, over_none) = if effects.is_empty() {
-                (None, None, None)
+            let expected = if effects.is_empty() {
+                None
             } else {
-                let (a, b, c) = oracle_margins(&base, &truth, &effects)?;
-                (Some(a), Some(b), Some(c))
+                Some(oracle::margins(&base, &truth, &effects, None)?)
             };
-            let fair = match (margin, over_none) {
-                (Some(a), Some(c)) if options.tied => a < RUNNER_UP_MARGIN && c >= NONE_MARGIN,
-                (Some(a), Some(c)) => a >= RUNNER_UP_MARGIN && c >= NONE_MARGIN,
-                _ => true,
+            let fair = match &expected {
+                Some(m) if options.tied => m.lead < RUNNER_UP_MARGIN && m.over_none >= NONE_MARGIN,
+                Some(m) => m.fair(),
+                None => true,
             };
             if options.conceal && !fair {
                 continue;
             }
+            let measured = with_noise(&truth, &noise);
+            // The record's own margins, for a concealed effect that is not a tie (a tie is the
+            // expected lead's property on its input; design works from it).
+            let realized = match &expected {
+                Some(m) if options.conceal && !options.tied => {
+                    let flat = measured.concat();
+                    Some(oracle::margins(&base, &flat, &effects, Some(&m.own_fit))?)
+                }
+                _ => None,
+            };
+            if realized.as_ref().is_some_and(|r| !r.fair()) {
+                continue;
+            }
             return Ok(assemble_case(
                 options,
-                &base,
                 &voltage,
                 r_true,
                 &hidden,
-                &truth,
+                measured,
                 peak,
                 r_refit,
                 target,
                 input,
                 rung != first,
-                margin,
-                runner_up,
-                over_none,
+                expected,
+                realized,
                 attempts,
             ));
         }
@@ -467,35 +394,48 @@ pub fn make_case(options: &CaseOptions) -> Result<Case, Error> {
     Err(Error::setting("effect", options.effects.join(","), why))
 }
 
-/// The recording with its noise drawn, and the answer.
+/// The seed's noise on each channel: σ_I then σ_ω, a sample at a time.
+fn noise_draw(seed: u64) -> Vec<Vec<f64>> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x6e6f_6973_6500);
+    (0..2)
+        .map(|c| {
+            let normal = Normal::new(0.0, NOISE_SD[c]).expect("σ > 0");
+            (0..SAMPLES).map(|_| normal.sample(&mut rng)).collect()
+        })
+        .collect()
+}
+
+/// The channels measured: the noise-free truth (channel-major) plus the noise.
+fn with_noise(truth: &[f64], noise: &[Vec<f64>]) -> Vec<Vec<f64>> {
+    noise
+        .iter()
+        .enumerate()
+        .map(|(c, n)| {
+            (0..SAMPLES)
+                .map(|i| truth[c * SAMPLES + i] + n[i])
+                .collect()
+        })
+        .collect()
+}
+
+/// The recording of the measured channels, and the answer.
 #[allow(clippy::too_many_arguments)]
 fn assemble_case(
     options: &CaseOptions,
-    base: &Problem,
     voltage: &VoltageInput,
     r_true: f64,
     hidden: &[(String, Vec<f64>)],
-    truth: &[f64],
+    measured: Vec<Vec<f64>>,
     peak: [f64; 2],
     r_refit: f64,
     target: f64,
     input: InputProfile,
     input_fallback: bool,
-    margin: Option<f64>,
-    runner_up: Option<String>,
-    over_none: Option<f64>,
+    expected: Option<oracle::Margins>,
+    realized: Option<oracle::Margins>,
     attempts: usize,
 ) -> Case {
-    let times = base.recordings[0].time.clone();
-    let mut rng = ChaCha8Rng::seed_from_u64(options.seed ^ 0x6e6f_6973_6500);
-    let measured: Vec<Vec<f64>> = (0..2)
-        .map(|c| {
-            let normal = Normal::new(0.0, NOISE_SD[c]).expect("σ > 0");
-            (0..SAMPLES)
-                .map(|i| truth[c * SAMPLES + i] + normal.sample(&mut rng))
-                .collect()
-        })
-        .collect();
+    let times = sample_times(DURATION, SAMPLES);
     let recording = Recording {
         source: "motorcal simulate --effect".into(),
         time: times,
@@ -552,9 +492,12 @@ fn assemble_case(
             ("omega".into(), peak[1]),
         ]),
         r_of_refitted_nominal: r_refit,
-        oracle_margin: margin,
-        oracle_runner_up: runner_up,
-        oracle_margin_over_none: over_none,
+        oracle_margin: expected.as_ref().map(|m| m.lead),
+        oracle_runner_up: expected.as_ref().map(|m| m.runner_up.clone()),
+        oracle_margin_over_none: expected.as_ref().map(|m| m.over_none),
+        oracle_margin_realized: realized.as_ref().map(|m| m.lead),
+        oracle_runner_up_realized: realized.as_ref().map(|m| m.runner_up.clone()),
+        oracle_margin_over_none_realized: realized.as_ref().map(|m| m.over_none),
         attempts,
     };
     Case {

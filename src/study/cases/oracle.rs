@@ -1,12 +1,16 @@
 //! The generator's identifiability oracle, independent of `diagnose`'s scoring: weighted least
 //! squares with the noise σ known (no priors, no sampled σ), by projected Levenberg–Marquardt on
-//! the forward model's sensitivities, on the *noise-free* truth. Its expected score of a model is
-//! −½·SS/σ² at the best fit − ½·d·ln N, the BIC's nats; a case is fair when the true form's
-//! expected score leads every other one-effect model by [`RUNNER_UP_MARGIN`] and the nominal
-//! model by [`NONE_MARGIN`] (the development set's BIC margins of 6 and 10, halved to nats).
-//! Judging on the noise-free truth asks whether the *effect* is identifiable on this input, not
-//! whether this noise draw happens to cooperate, so a case the tool then gets wrong still counts.
-
+//! the forward model's sensitivities. Its score of a model is −½·SS/σ² at the best fit −
+//! ½·d·ln N, the BIC's nats; a case is fair when the true form's score leads every other
+//! one-effect model by [`RUNNER_UP_MARGIN`] and the nominal model by [`NONE_MARGIN`] (the
+//! development set's BIC margins of 6 and 10, halved to nats).
+//!
+//! Both on the noise-free truth and on the noisy record, as the development set's README says
+//! of its own cases ("also on the noise-free truth"). The noise-free margin asks whether the
+//! *effect* is identifiable on this input; the record's asks whether this record holds it. A
+//! draw whose noise hides an effect the noise-free truth shows is one no method can name — the
+//! oracle itself, knowing the truth's form, does not find it there — and the development set
+//! and its holdouts redraw it: so does this generator.
 use nalgebra::{DMatrix, DVector};
 
 use crate::error::Error;
@@ -14,6 +18,9 @@ use crate::motor::Term;
 use crate::ode::SolverSettings;
 use crate::parameter::Support;
 use crate::study::Problem;
+use crate::study::frequency_grid::{frequency_search_cost, searched_frequencies};
+
+use super::{DURATION, NOISE_SD, SAMPLES};
 
 // The starts across a switching time's range are diagnose's: a list of fractions, no scoring.
 use crate::study::BOUNDED_STARTS;
@@ -42,6 +49,18 @@ pub fn least_squares_set(
     set: &[Term],
     target: &[f64],
     noise_sd: &[f64],
+) -> Result<(f64, Vec<f64>), Error> {
+    least_squares_from(base, added, set, target, noise_sd, None)
+}
+
+/// As [`least_squares_set`], started also from `extra` where given.
+pub fn least_squares_from(
+    base: &Problem,
+    added: &[String],
+    set: &[Term],
+    target: &[f64],
+    noise_sd: &[f64],
+    extra: Option<&[f64]>,
 ) -> Result<(f64, Vec<f64>), Error> {
     let mut problem = base.with_terms(added)?;
     for active in &mut problem.model.terms {
@@ -82,6 +101,9 @@ pub fn least_squares_set(
                 })
                 .collect();
         }
+    }
+    if let Some(e) = extra.filter(|e| e.len() == start.len()) {
+        starts.push(e.to_vec());
     }
     let mut best = (f64::INFINITY, start);
     let fit_from = |starts: &[Vec<f64>], best: &mut (f64, Vec<f64>)| {
@@ -134,6 +156,124 @@ pub fn least_squares_set(
         )));
     }
     Ok(best)
+}
+
+/// The oracle's score margins of a truth with `effects` on `target` (the noise-free truth, or
+/// the noisy record): its lead over the best alternative, that alternative's name, its lead
+/// over none, and the truth's form fitted. The alternatives of one effect are every other
+/// one-effect model and none; of two effects, each of the two alone and every pair that swaps
+/// one of them for another term. `own_start`, where given, is a further start of the truth's
+/// own form (its fit to the noise-free truth), so that its fit to a noisy record is not lost
+/// to a far valley of a frequency or a switching time.
+pub fn margins(
+    base: &Problem,
+    target: &[f64],
+    effects: &[String],
+    own_start: Option<&[f64]>,
+) -> Result<Margins, Error> {
+    let n = (2 * SAMPLES) as f64;
+    // A resonance's frequency no one knows is searched for: `diagnose` starts the coupling at
+    // the best of G frequencies and charges it ln G in place of its ½·ln N, and so does the
+    // oracle, so that a case it makes is one `diagnose`'s own score can find.
+    let searched = frequency_search_cost(searched_frequencies(DURATION, SAMPLES), 2 * SAMPLES);
+    let score_from = |added: &[String], set: &[Term], extra: Option<&[f64]>| {
+        let problem = base.with_terms(added)?;
+        let d = problem.calibrated_names()?.len() as f64 - 1.0;
+        let (ss, theta) = least_squares_from(base, added, set, target, &NOISE_SD, extra)?;
+        let search = if added.iter().any(|a| a == "compliant_coupling") {
+            searched
+        } else {
+            0.0
+        };
+        Ok::<_, Error>((-0.5 * ss - 0.5 * d * n.ln() - search, theta))
+    };
+    let score = |added: &[String]| score_from(added, &[], None).map(|(s, _)| s);
+    let (own, own_fit) = score_from(effects, &[], own_start)?;
+    let none = score(&[])?;
+    let mut alternatives: Vec<Vec<String>> = Vec::new();
+    let others: Vec<String> = Term::NAMES
+        .iter()
+        .filter(|t| !effects.iter().any(|e| e == *t))
+        .map(|t| t.to_string())
+        .collect();
+    if effects.len() == 1 {
+        alternatives.extend(others.iter().map(|o| vec![o.clone()]));
+    } else {
+        for (i, kept) in effects.iter().enumerate() {
+            alternatives.push(vec![kept.clone()]);
+            for o in &others {
+                let mut pair = effects.to_vec();
+                pair[1 - i] = o.clone();
+                alternatives.push(pair);
+            }
+        }
+    }
+    let mut runner_up = ("none".to_string(), none);
+    for alt in alternatives {
+        let s = score(&alt)?;
+        if s > runner_up.1 {
+            runner_up = (alt.join("+"), s);
+        }
+        // A term with a choice among channels is an alternative on each of them: `diagnose`
+        // fits a lag on whichever channel the residual points to.
+        for set in choice_variants(&alt) {
+            let (s, _) = score_from(&alt, std::slice::from_ref(&set), None)?;
+            if s > runner_up.1 {
+                runner_up = (format!("{} ({:?})", alt.join("+"), set), s);
+            }
+        }
+    }
+    Ok(Margins {
+        lead: own - runner_up.1,
+        runner_up: runner_up.0,
+        over_none: own - none,
+        own_fit,
+    })
+}
+
+/// What [`margins`] finds.
+#[derive(Clone, Debug)]
+pub struct Margins {
+    /// The truth's score lead over the best alternative (nats).
+    pub lead: f64,
+    pub runner_up: String,
+    /// The truth's score lead over the nominal model (nats).
+    pub over_none: f64,
+    /// The truth's own form fitted to the target.
+    pub own_fit: Vec<f64>,
+}
+
+impl Margins {
+    /// Whether the truth stands out by the development set's margins.
+    pub fn fair(&self) -> bool {
+        self.lead >= RUNNER_UP_MARGIN && self.over_none >= NONE_MARGIN
+    }
+}
+
+/// The terms among `names` with a setting that chooses (a channel), at each choice other than
+/// the default.
+fn choice_variants(names: &[String]) -> Vec<Term> {
+    let mut out = Vec::new();
+    for name in names {
+        let (Some((_, settings)), Some(term)) = (Term::declarations(name), Term::named(name))
+        else {
+            continue;
+        };
+        let defaults = term.settings();
+        for (k, s) in settings.iter().enumerate() {
+            for index in 0..s.choices.len() {
+                if index as f64 == defaults[k] {
+                    continue;
+                }
+                let mut values = defaults.clone();
+                values[k] = index as f64;
+                if let Some(Ok(t)) = Term::from_name(name, &values) {
+                    out.push(t);
+                }
+            }
+        }
+    }
+    out
 }
 
 fn residual_ss(out: &[f64], target: &[f64], weights: &[f64]) -> f64 {
@@ -228,9 +368,7 @@ fn project(support: &Support, x: f64) -> f64 {
 
 #[cfg(test)]
 mod tests {
-    use super::super::{
-        DURATION, NOISE_SD, SAMPLES, choice_variants, nominal_problem, truth_output,
-    };
+    use super::super::{CaseOptions, make_case, nominal_problem, truth_output};
     use super::*;
     use crate::study::InputProfile;
     use crate::synthetic::sample_times;
@@ -265,5 +403,41 @@ mod tests {
             ss_lag < 0.25 * ss_none,
             "SS/σ²: lag {ss_lag}, none {ss_none}"
         );
+    }
+
+    /// A concealed case's record holds its effect. A coupling of seed 1300024 on the constant
+    /// input led no effect by 6.6 nats on the noise-free truth, and the generator made it when
+    /// it judged that alone; on its noisy record the oracle's own fit of the truth's form led
+    /// by 1.8 (`diagnose` ranked it at +1.4, under its 2 nats). Such a draw is now redrawn:
+    /// the case made has the margins on its own record, recomputed here from the recording.
+    #[test]
+    fn a_concealed_case_is_one_whose_own_record_holds_the_effect() {
+        let effects = vec!["compliant_coupling".to_string()];
+        let case = make_case(&CaseOptions {
+            effects: effects.clone(),
+            magnitude: None,
+            input: InputProfile::Constant,
+            seed: 1_300_024,
+            conceal: true,
+            tied: false,
+        })
+        .unwrap();
+        let times = sample_times(DURATION, SAMPLES);
+        let base = nominal_problem(&InputProfile::Constant.voltage(24.0, &times), &times);
+        let record: Vec<f64> = case
+            .recording
+            .channels
+            .iter()
+            .flat_map(|(_, v)| v.iter().copied())
+            .collect();
+        let on_record = margins(&base, &record, &effects, None).unwrap();
+        assert!(on_record.fair(), "{on_record:?}");
+        let said = case.answer.oracle_margin_over_none_realized.unwrap();
+        assert!(
+            (said - on_record.over_none).abs() < 0.5,
+            "{said} vs {}",
+            on_record.over_none
+        );
+        assert!(case.answer.oracle_margin.unwrap() >= RUNNER_UP_MARGIN);
     }
 }
