@@ -4,7 +4,7 @@
 //! by weighted least squares) peaks at a chosen multiple of the noise σ, 501 samples over
 //! 0.5 s with σ_I = 2 A and σ_ω = 10 rad/s. `--conceal` keeps that peak below 1.5σ and redraws a
 //! case until the oracle ([`oracle`]) finds the effect identifiable on the noise-free truth and
-//! on the noisy record (not for a tie: there, the noise-free truth's tie on its input); an
+//! the noisy record holding it (leading none); an
 //! effect that is not identifiable on the asked input after [`REDRAWS`] draws moves to a richer
 //! one (constant → step → reversal → square), recorded in `answer.json`.
 
@@ -84,7 +84,7 @@ pub struct Answer {
     pub oracle_runner_up: Option<String>,
     pub oracle_margin_over_none: Option<f64>,
     /// The same on the noisy record (a concealed effect's; absent otherwise), with the truth's
-    /// form refitted to it: a concealed case is made only where both lead by the margins.
+    /// form refitted to it: a concealed case is made only where it leads none by the margin.
     pub oracle_margin_realized: Option<f64>,
     pub oracle_runner_up_realized: Option<String>,
     pub oracle_margin_over_none_realized: Option<f64>,
@@ -352,8 +352,11 @@ pub fn make_case(options: &CaseOptions) -> Result<Case, Error> {
                 continue;
             }
             let measured = with_noise(&truth, &noise);
-            // The record's own margins, for a concealed effect that is not a tie (a tie is the
-            // expected lead's property on its input; design works from it).
+            // The record must hold the effect: its own lead over none (the truth's form refitted
+            // to it) by the margin. Not its lead over a look-alike: a record on which the truth
+            // ties with one is a fair case whose right answer is the tie and the experiment that
+            // separates it (issue 20's cases), where a record that holds no effect has no right
+            // answer at all. A tie asked for keeps the noise-free tie alone.
             let realized = match &expected {
                 Some(m) if options.conceal && !options.tied => {
                     let flat = measured.concat();
@@ -361,7 +364,7 @@ pub fn make_case(options: &CaseOptions) -> Result<Case, Error> {
                 }
                 _ => None,
             };
-            if realized.as_ref().is_some_and(|r| !r.fair()) {
+            if realized.as_ref().is_some_and(|r| r.over_none < NONE_MARGIN) {
                 continue;
             }
             return Ok(assemble_case(

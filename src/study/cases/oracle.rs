@@ -5,12 +5,14 @@
 //! one-effect model by [`RUNNER_UP_MARGIN`] and the nominal model by [`NONE_MARGIN`] (the
 //! development set's BIC margins of 6 and 10, halved to nats).
 //!
-//! Both on the noise-free truth and on the noisy record, as the development set's README says
-//! of its own cases ("also on the noise-free truth"). The noise-free margin asks whether the
-//! *effect* is identifiable on this input; the record's asks whether this record holds it. A
-//! draw whose noise hides an effect the noise-free truth shows is one no method can name — the
-//! oracle itself, knowing the truth's form, does not find it there — and the development set
-//! and its holdouts redraw it: so does this generator.
+//! On the noise-free truth, and on the noisy record for the lead over none. The noise-free
+//! margins ask whether the *effect* is identifiable on this input; the record's lead over none
+//! asks whether this record holds it at all. A draw whose noise hides an effect the noise-free
+//! truth shows is one no method can name (the oracle itself, knowing the truth's form, does not
+//! find it there), and it is redrawn, as the development set's README redraws its own. The
+//! README also asks the record's lead over the runner-up; this generator does not: a record on
+//! which the truth ties with a look-alike is a case whose right answer is the tie (and the
+//! experiment that separates it), the cases `motorcal design` is for.
 use nalgebra::{DMatrix, DVector};
 
 use crate::error::Error;
@@ -409,7 +411,7 @@ mod tests {
     /// input led no effect by 6.6 nats on the noise-free truth, and the generator made it when
     /// it judged that alone; on its noisy record the oracle's own fit of the truth's form led
     /// by 1.8 (`diagnose` ranked it at +1.4, under its 2 nats). Such a draw is now redrawn:
-    /// the case made has the margins on its own record, recomputed here from the recording.
+    /// the case made leads none on its own record, recomputed here from the recording.
     #[test]
     fn a_concealed_case_is_one_whose_own_record_holds_the_effect() {
         let effects = vec!["compliant_coupling".to_string()];
@@ -431,7 +433,7 @@ mod tests {
             .flat_map(|(_, v)| v.iter().copied())
             .collect();
         let on_record = margins(&base, &record, &effects, None).unwrap();
-        assert!(on_record.fair(), "{on_record:?}");
+        assert!(on_record.over_none >= NONE_MARGIN, "{on_record:?}");
         let said = case.answer.oracle_margin_over_none_realized.unwrap();
         assert!(
             (said - on_record.over_none).abs() < 0.5,
