@@ -20,9 +20,12 @@ done
 $STUDY --per-effect 5 --null 40 --two 20 --seed-base 1100000 --out /tmp/s15/study > $B/study-1100000-session15/log.txt
 cp /tmp/s15/study/study.csv /tmp/s15/study/study.json $B/study-1100000-session15/
 python3 $B/compare_studies.py $B/study-1100000-session14/study.csv $B/study-1100000-session15/study.csv > $HERE/compare-study-1100000.txt
-# 3. Which cases the generator made differently (printed into redrawn-cases.txt by the inline
-#    Python of session 15's shell history, comparing each study's session-14 and session-15
-#    study.csv by oracle_margin and input).
+# 3. Which cases the generator made differently from session 14's runs of the same seeds.
+python3 $HERE/redrawn_cases.py \
+  study-1100000 $B/study-1100000-session14/study.csv $B/study-1100000-session15/study.csv \
+  terms-1200000 $B/terms-1200000-session14/study.csv $B/terms-1200000-session15/study.csv \
+  terms-1300000 $B/terms-1300000-session14/study.csv $B/terms-1300000-session15/study.csv \
+  > $HERE/redrawn-cases.txt
 # 4. The three coupling misses' draws, traced: a temporary eprintln! in make_case printing the
 #    redrawn draw's margins (not kept), `motorcal simulate --effect compliant_coupling --conceal
 #    --seed S --input I` for 1300024 constant, 1300032 constant, 1200004 reversal:
