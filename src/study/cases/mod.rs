@@ -83,10 +83,9 @@ pub struct Answer {
     pub oracle_margin: Option<f64>,
     pub oracle_runner_up: Option<String>,
     pub oracle_margin_over_none: Option<f64>,
-    /// The same on the noisy record (a concealed effect's; absent otherwise), with the truth's
-    /// form refitted to it: a concealed case is made only where it leads none by the margin.
-    pub oracle_margin_realized: Option<f64>,
-    pub oracle_runner_up_realized: Option<String>,
+    /// The truth's lead over none on the noisy record (a concealed effect's; absent
+    /// otherwise), its form refitted to it: a concealed case is made only where it clears
+    /// [`NONE_MARGIN`].
     pub oracle_margin_over_none_realized: Option<f64>,
     pub attempts: usize,
 }
@@ -341,7 +340,7 @@ pub fn make_case(options: &CaseOptions) -> Result<Case, Error> {
             let expected = if effects.is_empty() {
                 None
             } else {
-                Some(oracle::margins(&base, &truth, &effects, None)?)
+                Some(oracle::margins(&base, &truth, &effects)?)
             };
             let fair = match &expected {
                 Some(m) if options.tied => m.lead < RUNNER_UP_MARGIN && m.over_none >= NONE_MARGIN,
@@ -358,13 +357,15 @@ pub fn make_case(options: &CaseOptions) -> Result<Case, Error> {
             // separates it (issue 20's cases), where a record that holds no effect has no right
             // answer at all. A tie asked for keeps the noise-free tie alone.
             let realized = match &expected {
-                Some(m) if options.conceal && !options.tied => {
-                    let flat = measured.concat();
-                    Some(oracle::margins(&base, &flat, &effects, Some(&m.own_fit))?)
-                }
+                Some(m) if options.conceal && !options.tied => Some(oracle::lead_over_none(
+                    &base,
+                    &measured.concat(),
+                    &effects,
+                    &m.own_fit,
+                )?),
                 _ => None,
             };
-            if realized.as_ref().is_some_and(|r| r.over_none < NONE_MARGIN) {
+            if realized.is_some_and(|r| r < NONE_MARGIN) {
                 continue;
             }
             return Ok(assemble_case(
@@ -435,7 +436,7 @@ fn assemble_case(
     input: InputProfile,
     input_fallback: bool,
     expected: Option<oracle::Margins>,
-    realized: Option<oracle::Margins>,
+    realized: Option<f64>,
     attempts: usize,
 ) -> Case {
     let times = sample_times(DURATION, SAMPLES);
@@ -498,9 +499,7 @@ fn assemble_case(
         oracle_margin: expected.as_ref().map(|m| m.lead),
         oracle_runner_up: expected.as_ref().map(|m| m.runner_up.clone()),
         oracle_margin_over_none: expected.as_ref().map(|m| m.over_none),
-        oracle_margin_realized: realized.as_ref().map(|m| m.lead),
-        oracle_runner_up_realized: realized.as_ref().map(|m| m.runner_up.clone()),
-        oracle_margin_over_none_realized: realized.as_ref().map(|m| m.over_none),
+        oracle_margin_over_none_realized: realized,
         attempts,
     };
     Case {
