@@ -10,6 +10,9 @@ use super::error::{InputError, read_text};
 use super::table::{self, Line};
 use crate::motor::{Base, DriveSettings, SampledDrive, VoltageInput};
 
+/// Samples over which a position loop's measured axis speed is taken for its speed scale.
+const POSITION_SPEED_WINDOW: usize = 10;
+
 /// Which CSV column holds what the model needs. Keys in a model file's `[channels]` table.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -129,18 +132,29 @@ impl Recording {
             ),
             Base::PositionLoop => {
                 let reference = self.input("q_ref")?;
-                let reference_speed = (1..m)
-                    .map(|i| {
-                        ((reference[i] - reference[i - 1]) / (self.time[i] - self.time[i - 1]))
-                            .abs()
-                    })
-                    .fold(0.0f64, f64::max);
+                // The fastest a series moves over `w` samples.
+                let fastest = |v: &[f64], w: usize| {
+                    (w..m)
+                        .map(|i| ((v[i] - v[i - w]) / (self.time[i] - self.time[i - w])).abs())
+                        .fold(0.0f64, f64::max)
+                };
+                // The reference's speed, unless the axis moves slower: a stepped reference (a
+                // designed one) jumps faster than any axis, and the scale is the axis's then.
+                // The axis's speed is taken over ten samples, where the position's noise
+                // weighs a tenth of what it does between two.
+                let mut speed = fastest(reference, 1);
+                if let Some(q) = self.channel("q") {
+                    let axis = fastest(q, POSITION_SPEED_WINDOW.min(m.saturating_sub(1)).max(1));
+                    if axis > 0.0 {
+                        speed = speed.min(axis);
+                    }
+                }
                 (
                     reference.to_vec(),
                     self.input("disturbance")
                         .map_or_else(|| vec![0.0; m], |d| d.to_vec()),
                     self.channel("q").map_or(reference[0], |q| q[0]),
-                    reference_speed,
+                    speed,
                 )
             }
         };
@@ -430,6 +444,34 @@ mod tests {
         let path = dir.join(name);
         std::fs::write(&path, contents).unwrap();
         path
+    }
+
+    #[test]
+    fn a_position_loop_s_speed_scale_is_the_axis_s_where_its_reference_jumps() {
+        let time: Vec<f64> = (0..40).map(|i| i as f64 * 0.001).collect();
+        // A reference stepping 0.05 m at one sample (50 m/s) and an axis moving at 0.2 m/s.
+        let reference: Vec<f64> = time
+            .iter()
+            .map(|&t| if t < 0.0015 { 0.0 } else { 0.05 })
+            .collect();
+        let axis: Vec<f64> = time.iter().map(|&t| 0.2 * t).collect();
+        let record = |q: Vec<f64>, q_ref: Vec<f64>| Recording {
+            time: time.clone(),
+            channels: vec![("q".into(), q), ("force".into(), vec![0.0; 40])],
+            inputs: vec![("q_ref".into(), q_ref)],
+            ..Recording::default()
+        };
+        let scale = |r: &Recording| {
+            r.sampled_drive(Base::PositionLoop, &DriveSettings::default())
+                .unwrap()
+                .speed_scale
+        };
+        assert!((scale(&record(axis.clone(), reference)) - 0.2).abs() < 1e-9);
+        // A reference the axis follows (EMPS's) keeps its own speed, and an axis at rest (a
+        // placeholder before a simulation) leaves the reference's.
+        let slower: Vec<f64> = time.iter().map(|&t| 0.1 * t).collect();
+        assert!((scale(&record(axis, slower.clone())) - 0.1).abs() < 1e-9);
+        assert!((scale(&record(vec![0.0; 40], slower)) - 0.1).abs() < 1e-9);
     }
 
     #[test]
