@@ -1,8 +1,8 @@
 //! `motorcal design` on a `current_driven` model: the designed input is a current command
 //! (`input.csv` is `t,I`) within the current limit that keeps ω within the speed limit, it
-//! separates a tie better than the fixed reversal and step (run in current), a `position_loop`
-//! model is refused by name, and `simulate --input` plays a `t,I` file back into a recording —
-//! the loop design → simulate → diagnose closes.
+//! separates a tie better than the fixed reversal and step (run in current), and `simulate
+//! --input` plays a `t,I` file back into a recording — the loop design → simulate → diagnose
+//! closes. A `position_loop`'s design is `tests/design_position.rs`'s.
 
 mod cli_support;
 
@@ -277,33 +277,6 @@ fn on_hsm150_the_designed_current_beats_the_reversal_at_the_default_settings() {
         d.expected_gap_nats,
         reversal.expected_gap_nats
     );
-}
-
-#[test]
-fn a_position_loop_model_is_refused_by_name() {
-    let emps = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/emps/model.toml");
-    let out = scratch("design-current", "position").join("design");
-    let o = motorcal(&[
-        "design",
-        "--model",
-        emps.to_str().unwrap(),
-        "--pin",
-        "J",
-        "--duration",
-        "0.05",
-        "--rate",
-        "400",
-        "--limits",
-        "U=±24,I=±300,omega=±3000",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    one_error_line(&o, &["--model", "position_loop", "reference position"]);
-    assert!(!out.exists());
-    let model = read_model_file(&emps).unwrap();
-    let times = design_times(0.05, 400.0).unwrap();
-    let limits: Limits = "U=±24,I=±300,omega=±3000".parse().unwrap();
-    assert!(design_problem(&model, &times, &limits).is_err());
 }
 
 #[test]

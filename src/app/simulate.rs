@@ -69,11 +69,12 @@ pub struct SimulateOptions {
     pub seed: u64,
     /// The input: a profile (constant, step, reversal, square) or the path of a `t,U` file
     /// (a designed or recorded input; `t,I` for a current_driven truth, the commanded
-    /// current), whose times the recording then takes.
+    /// current; `t,q_ref` for a position_loop truth, the reference position), whose times the
+    /// recording then takes.
     #[arg(long, default_value = "constant", value_parser = InputSource::parse)]
     pub input: InputSource,
     /// Noise standard deviations of I [A] and ω [rad/s] (a current_driven truth measures ω
-    /// alone and takes SD_OMEGA).
+    /// alone and takes SD_OMEGA; a position_loop truth takes them for q and the force).
     #[arg(long, num_args = 2, value_names = ["SD_I", "SD_OMEGA"], default_values_t = [2.0, 10.0])]
     pub noise_sd: Vec<f64>,
     /// Samples of the record (default 501; an input file's rows otherwise).
@@ -256,9 +257,10 @@ pub fn simulate(options: &SimulateOptions) -> Result<SimulateReport, AppError> {
             if truth_file.base.is_drive() {
                 return Err(AppError::Usage(format!(
                     "--input {}: a {} truth is driven by a recorded input; give the path of a \
-                     t,I file (the commanded current)",
+                     t,{} file",
                     profile.name(),
-                    truth_file.base.name()
+                    truth_file.base.name(),
+                    crate::study::input_column(truth_file.base).map_err(truth_error)?
                 )));
             }
             let samples = options.samples.unwrap_or(DEFAULT_SAMPLES);

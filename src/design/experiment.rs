@@ -2,10 +2,14 @@
 //! sample times under any input, with the noise σ the recording showed.
 //!
 //! The input a design searches is the one the model is driven by ([`Commanded`]): the voltage of
-//! the voltage-driven motor, or the current a `current_driven` drive is commanded (the drive
-//! closes the current loop, so the current is what a recorder plays back and the model
-//! measures ω alone). Either travels as a [`VoltageInput`] held between times; for a
-//! current-driven candidate its values are amperes.
+//! the voltage-driven motor, the current a `current_driven` drive is commanded (the drive closes
+//! the current loop, so the current is what a recorder plays back and the model measures ω
+//! alone), or the reference position of a `position_loop` (its controller turns the reference
+//! into the force; the model measures q and the force). Each travels as a [`VoltageInput`] held
+//! between times; for a drive its values are amperes, or for a position loop the reference's
+//! speed, which the reference integrates ([`Commanded::played`]): a piecewise-constant
+//! position would be a string of steps the loop answers at its saturation, which tells little
+//! and fits badly, where a move at a designed speed is what an axis is commissioned with.
 
 use std::collections::BTreeMap;
 
@@ -26,30 +30,28 @@ pub enum Commanded {
     Voltage,
     /// The current I a `current_driven` drive is commanded [A].
     Current,
+    /// The reference position q_ref of a `position_loop` [m on a linear axis], designed as its
+    /// speed: the levels are the reference's speed [m/s], the reference their integral from
+    /// q = 0, where the axis starts at rest.
+    Position,
 }
 
 impl Commanded {
-    /// What a model of `base` is driven by; a `position_loop` model is refused: its input is a
-    /// reference position fed through a controller, which design does not search.
+    /// What a model of `base` is driven by.
     pub fn of(base: Base) -> Result<Self, Error> {
-        match base {
-            Base::VoltageDriven => Ok(Commanded::Voltage),
-            Base::CurrentDriven => Ok(Commanded::Current),
-            Base::PositionLoop => Err(Error::setting(
-                "model",
-                "base = \"position_loop\"",
-                "design searches a voltage (voltage_driven) or a current command \
-                 (current_driven); a position_loop model's input is a reference position fed \
-                 through its controller, which design does not search",
-            )),
-        }
+        Ok(match base {
+            Base::VoltageDriven => Commanded::Voltage,
+            Base::CurrentDriven => Commanded::Current,
+            Base::PositionLoop => Commanded::Position,
+        })
     }
 
-    /// The column of `input.csv` that holds the levels (`U` or `I`).
+    /// The column of `input.csv`, what the drive is played (`U`, `I` or `q_ref`).
     pub fn column(&self) -> &'static str {
         match self {
             Commanded::Voltage => "U",
             Commanded::Current => "I",
+            Commanded::Position => "q_ref",
         }
     }
 
@@ -57,32 +59,77 @@ impl Commanded {
         match self {
             Commanded::Voltage => "V",
             Commanded::Current => "A",
+            Commanded::Position => "m",
         }
     }
 
-    /// The bound on the levels: the voltage limit, or for a current command the current limit
-    /// (U is then no input, and its limit is not used). A voltage-driven design without a
-    /// voltage limit is refused.
+    /// What a level is, and its unit: the input itself, or a reference's speed.
+    pub fn level(&self) -> (&'static str, &'static str) {
+        match self {
+            Commanded::Position => ("reference speed", "m/s"),
+            _ => (self.column(), self.unit()),
+        }
+    }
+
+    /// What the drive is played at `times` for the levels held there: the levels themselves,
+    /// or for a position loop the reference, their integral from 0 at the first sample, each
+    /// level held to the next sample (what a recorder plays, and the search sees).
+    pub fn played(&self, times: &[f64], levels: &[f64]) -> Vec<f64> {
+        if *self != Commanded::Position {
+            return levels.to_vec();
+        }
+        let mut at = 0.0;
+        let mut out = Vec::with_capacity(times.len());
+        for (k, &t) in times.iter().enumerate() {
+            if k > 0 {
+                at += levels[k - 1] * (t - times[k - 1]);
+            }
+            out.push(at);
+        }
+        out
+    }
+
+    /// The limits a design of this input needs: the level's own, and what the model measures
+    /// or moves at. A position loop's force needs none: its controller saturates
+    /// (`drive.input_limit`), and the speed is the axis's, from its position.
+    pub fn required_limits(&self) -> &'static [&'static str] {
+        match self {
+            Commanded::Voltage => &["U", "I", "omega"],
+            Commanded::Current => &["I", "omega"],
+            Commanded::Position => &["q", "omega"],
+        }
+    }
+
+    /// Refuses limits without one this input needs ([`Self::required_limits`]).
+    pub fn check_limits(&self, limits: &Limits) -> Result<(), Error> {
+        let why = match self {
+            Commanded::Voltage => "a voltage-driven design",
+            Commanded::Current => "a current_driven design (the current is what it commands)",
+            Commanded::Position => {
+                "a position_loop design (the reference's travel and the axis's speed)"
+            }
+        };
+        limits
+            .require(self.required_limits(), why)
+            .map_err(|message| Error::setting("limits", limits, message))
+    }
+
+    /// The bound on the levels: the voltage limit, the current limit for a current command (U
+    /// is then no input, and its limit is not used), or the speed limit for a reference's
+    /// speed (its travel is checked on the axis's position).
     pub fn level_limit(&self, limits: &Limits) -> Result<f64, Error> {
-        let limit = match self {
+        self.check_limits(limits)?;
+        Ok(match self {
             Commanded::Voltage => limits.voltage,
             Commanded::Current => limits.current,
-        };
-        if !limit.is_finite() {
-            return Err(Error::setting(
-                "limits",
-                limits,
-                format!(
-                    "give {}=±VALUE: the largest {} the design may command",
-                    self.column(),
-                    match self {
-                        Commanded::Voltage => "voltage",
-                        Commanded::Current => "current",
-                    }
-                ),
-            ));
-        }
-        Ok(limit)
+            Commanded::Position => limits.speed,
+        })
+    }
+
+    /// Whether the drive plays the levels sample by sample (the drive bases) rather than the
+    /// integrator switching exactly at the switching times (the voltage).
+    pub fn is_sampled(&self) -> bool {
+        *self != Commanded::Voltage
     }
 }
 
@@ -138,11 +185,14 @@ pub fn design_times(duration: f64, rate: f64) -> Result<Vec<f64>, Error> {
 }
 
 /// The user's model on the design's sampling: a problem whose one record is a placeholder at
-/// `times` (no data of it is fitted). A current-driven model's record carries the drive's input
-/// I and measures ω; the drive reads its scales from that record (the largest current it is
-/// commanded, the largest speed it reaches: what a term's default smoothing speed and the
-/// default priors are drawn to), so the placeholder holds the limits there, the most a designed
-/// record may command and reach. A `position_loop` model is refused ([`Commanded::of`]).
+/// `times` (no data of it is fitted). A drive reads its scales from that record (the largest
+/// input it is commanded, the largest speed it reaches: what a term's default smoothing speed
+/// and the default priors are drawn to), so the placeholder holds the limits there, the most a
+/// designed record may command and reach. A current-driven record carries the input I and
+/// measures ω. A position loop's record carries a reference and an axis that ramp from q = 0 at
+/// the speed limit (its speed scale: [`Recording::sampled_drive`]), and measures q and the
+/// force; a position loop without `drive.input_limit` is refused, since its saturation
+/// is what bounds the force a design may ask.
 pub fn design_problem(
     model: &crate::io::ModelFile,
     times: &[f64],
@@ -150,7 +200,9 @@ pub fn design_problem(
 ) -> Result<Problem, Error> {
     let m = times.len();
     let held = |v: f64| vec![if v.is_finite() { v } else { 0.0 }; m];
-    let (channels, inputs) = match Commanded::of(model.base)? {
+    let commanded = Commanded::of(model.base)?;
+    commanded.check_limits(limits)?;
+    let (channels, inputs) = match commanded {
         Commanded::Voltage => (
             vec![("I".into(), vec![0.0; m]), ("omega".into(), vec![0.0; m])],
             Vec::new(),
@@ -159,6 +211,22 @@ pub fn design_problem(
             vec![("omega".into(), held(limits.speed))],
             vec![("I".into(), held(limits.current))],
         ),
+        Commanded::Position => {
+            if model.drive.input_limit.is_none() {
+                return Err(Error::setting(
+                    "model",
+                    "drive.input_limit",
+                    "a position_loop design needs the controller's saturation (drive.input_limit): \
+                     it bounds the force the designed reference may ask",
+                ));
+            }
+            let t0 = times.first().copied().unwrap_or(0.0);
+            let ramp: Vec<f64> = times.iter().map(|t| limits.speed * (t - t0)).collect();
+            (
+                vec![("q".into(), ramp.clone()), ("force".into(), vec![0.0; m])],
+                vec![("q_ref".into(), ramp)],
+            )
+        }
     };
     Ok(Problem {
         label: "design".into(),
@@ -175,10 +243,15 @@ pub fn design_problem(
 }
 
 /// The σ a design assumes for a channel that neither the command line nor a diagnosis gives
-/// one for: the paper's, 2 A on I and 10 rad/s on ω.
-pub fn default_noise_sd(channel: &str) -> f64 {
+/// one for: the paper's, 2 A on I and 10 rad/s on ω; none for a position loop's q and force,
+/// whose scale is the rig's.
+pub fn default_noise_sd(channel: &str) -> Option<f64> {
     let [current, speed] = crate::study::cases::NOISE_SD;
-    if channel == "I" { current } else { speed }
+    match channel {
+        "I" => Some(current),
+        "omega" => Some(speed),
+        _ => None,
+    }
 }
 
 /// The candidate names a design can take: `none`, a library term, or terms joined by `+`.
@@ -227,33 +300,41 @@ impl Candidate {
     }
 
     /// The candidate's forward model under `input` at `times`, its calibrated parameters free.
-    /// For a current-driven candidate `input` is the commanded current: the drive holds its
-    /// value at each sample until the next (the drive's scales stay the placeholder record's,
-    /// see [`design_problem`]).
+    /// For a drive `input` is the commanded current or the reference's speed: the drive holds
+    /// its value at each sample until the next (the drive's scales stay the placeholder
+    /// record's, see [`design_problem`]); a position loop's axis starts at rest where its
+    /// reference starts ([`Commanded::played`]).
     pub fn forward(&self, input: &VoltageInput, times: &[f64]) -> Result<ForwardModel, Error> {
-        let model = match Commanded::of(self.problem.model.base)? {
+        let commanded = Commanded::of(self.problem.model.base)?;
+        let model = match commanded {
             Commanded::Voltage => self
                 .problem
                 .model
                 .model(input.clone())
                 .map_err(Error::invalid)?,
-            Commanded::Current => {
+            Commanded::Current | Commanded::Position => {
                 let mut model = self.problem.model_for(self.problem.recording())?;
                 let drive = model
                     .drive
                     .as_mut()
-                    .ok_or_else(|| Error::invalid("a current-driven model without its drive"))?;
+                    .ok_or_else(|| Error::invalid("a drive-base model without its drive"))?;
                 drive.times = times.to_vec();
-                drive.input = times
+                let levels = times
                     .iter()
                     .map(|&t| input.value_at(t))
                     .collect::<Option<Vec<f64>>>()
                     .ok_or_else(|| {
-                        Error::invalid(
-                            "a current-driven design needs a held current, not the constant U",
-                        )
+                        Error::invalid(format!(
+                            "a {} design needs a held {}, not the constant U",
+                            self.problem.model.base.name(),
+                            commanded.level().0
+                        ))
                     })?;
+                drive.input = commanded.played(times, &levels);
                 drive.disturbance = vec![0.0; times.len()];
+                if commanded == Commanded::Position {
+                    drive.initial_position = drive.input.first().copied().unwrap_or(0.0);
+                }
                 model
             }
         };
@@ -301,5 +382,24 @@ impl Experiment {
         (0..self.n_observations())
             .map(|row| 1.0 / self.noise_sd[row / m])
             .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_reference_is_the_integral_of_its_designed_speed() {
+        let times = [0.001, 0.002, 0.003, 0.004];
+        let speeds = [0.5, 0.5, -0.25, 9.0];
+        let played = Commanded::Position.played(&times, &speeds);
+        let expected = [0.0, 0.0005, 0.001, 0.00075];
+        for (p, e) in played.iter().zip(expected) {
+            assert!((p - e).abs() < 1e-15, "{played:?}");
+        }
+        // The other inputs are played as designed.
+        assert_eq!(Commanded::Current.played(&times, &speeds), speeds);
+        assert_eq!(Commanded::Position.level(), ("reference speed", "m/s"));
     }
 }

@@ -1,11 +1,12 @@
 //! `motorcal design`: the input to record next. Within the drive's limits, a piecewise-constant
-//! voltage of N segments — for a `current_driven` model a current command ([`Commanded`]) —
+//! voltage of N segments — for a `current_driven` model a current command, for a
+//! `position_loop` a reference position ([`Commanded`]) —
 //! that either tells candidate explanations apart (the expected evidence gap of each candidate
 //! as the truth over its best-fitting rival, [`separate`]) or pins named parameters (D-optimal
 //! on the Fisher matrix of the forward sensitivities, [`pin`]); beside it the fixed experiments
 //! `diagnose` tries for a tie ([`crate::discover::TIE_EXPERIMENTS`]) and for pinning the
-//! constant input: at the model's U, or for a current command at the largest current within
-//! the limits ([`fixed_inputs`]).
+//! constant input: at the model's U, or for a drive at the largest current or reference speed
+//! within the limits ([`fixed_inputs`]).
 //!
 //! The files: `profile` (the input and its free coordinates), `limits`, `experiment` (the
 //! candidates at their estimates, the sampling and σ), `fitted` (the candidates' estimates
@@ -14,13 +15,15 @@
 //! design's input, and the redesign with the rivals it finds). Nothing here reads or writes a file: `app::design` does.
 //!
 //! **Limits.** An input is judged on the noise-free predictions of every candidate at the
-//! record's samples: one whose |I| or |ω| passes its limit there is refused. The search runs on
-//! the continuous switching times with the current and speed limits 2% tighter ([`MARGIN`]);
+//! record's samples: one whose |I|, |ω| or a position loop's |q| passes its limit there is
+//! refused (a position loop's speed is its position's difference between samples). The search
+//! runs on the continuous switching times with the current, speed and travel limits 2% tighter
+//! ([`MARGIN`]), a reference's speeds too, since the axis follows them;
 //! the input written switches at the first sample at or after each switching time, and is
 //! checked again against the limits themselves — an input that then passes one is an error,
-//! never clipped. A current-driven model is integrated at its samples with the current held
-//! over each sample interval ([`crate::motor::SampledDrive`]): its search sees a switch at the
-//! first sample at or after it already, so what it finds is what is written.
+//! never clipped. A drive is integrated at its samples with its input held over each sample
+//! interval ([`crate::motor::SampledDrive`]): its search sees a switch at the first sample at or
+//! after it already, so what it finds is what is written.
 
 mod experiment;
 mod fitted;
@@ -53,7 +56,7 @@ use crate::error::Error;
 use crate::motor::VoltageInput;
 use crate::study::InputProfile;
 
-/// The search keeps |I| and |ω| this fraction inside their limits (see the module's notes).
+/// The search keeps |I|, |ω| and |q| this fraction inside their limits (see the module's notes).
 pub const MARGIN: f64 = 0.98;
 
 /// Monte Carlo records per truth for a reported gap.
@@ -76,7 +79,7 @@ pub struct DesignSettings {
 pub struct InputCheck {
     pub input: String,
     pub within_limits: bool,
-    /// Peak |I| and |ω| over the candidates.
+    /// Peak |I| and |ω| (a position loop: |q| and the axis's |ω|) over the candidates.
     pub peaks: std::collections::BTreeMap<String, f64>,
 }
 
@@ -96,7 +99,7 @@ pub struct FixedSeparation {
 pub struct SeparationDesign {
     pub profile: Profile,
     pub times: Vec<f64>,
-    /// The voltage (a current-driven model: the current) at each sample time: `input.csv`.
+    /// The voltage (a drive: the current or the reference) at each sample time: `input.csv`.
     pub values: Vec<f64>,
     pub check: InputCheck,
     /// The smallest expected gap over the truths (the design's guarantee), its truth's sd.
@@ -118,11 +121,7 @@ pub struct PinDesign {
 }
 
 fn no_limits() -> Limits {
-    Limits {
-        voltage: f64::INFINITY,
-        current: f64::INFINITY,
-        speed: f64::INFINITY,
-    }
+    Limits::open()
 }
 
 fn check(
@@ -139,8 +138,8 @@ fn check(
         forward
             .simulate(&c.theta, &mut y)
             .map_err(|e| Error::Numerical(e.to_string()))?;
-        within &= limits.excess(forward.channels(), &y) == 0.0;
-        for (channel, peak) in limits.peaks(forward.channels(), &y) {
+        within &= limits.excess(forward.channels(), &y, &experiment.times) == 0.0;
+        for (channel, peak) in limits.peaks(forward.channels(), &y, &experiment.times) {
             let slot = peaks.entry(channel).or_insert(0.0f64);
             *slot = slot.max(peak);
         }
@@ -192,8 +191,8 @@ fn check_possible(experiment: &Experiment, limits: &Limits) -> Result<(), Error>
             format!(
                 "no input can meet these limits: a constant {u} {} (1% of the {} limit) \
                  already reaches {}",
-                commanded.unit(),
-                commanded.column(),
+                commanded.level().1,
+                commanded.level().0,
                 peaks.join(", ")
             ),
         ));
@@ -205,6 +204,8 @@ fn tightened(limits: &Limits) -> Limits {
     Limits {
         current: limits.current * MARGIN,
         speed: limits.speed * MARGIN,
+        position: limits.position * MARGIN,
+        force: limits.force * MARGIN,
         ..*limits
     }
 }
@@ -228,7 +229,12 @@ fn search_profile<F: Fn(&VoltageInput) -> f64 + Sync>(
             "a design needs at least one segment",
         ));
     }
-    let u_max = experiment.commanded()?.level_limit(&settings.limits)?;
+    // A reference's speeds keep the speed's margin: the axis follows them.
+    let commanded = experiment.commanded()?;
+    let u_max = match commanded {
+        Commanded::Position => commanded.level_limit(&tightened(&settings.limits))?,
+        _ => commanded.level_limit(&settings.limits)?,
+    };
     let starts: Vec<Vec<f64>> = search::starts(&settings.search, duration, u_max)
         .iter()
         .chain(extra)
@@ -259,9 +265,9 @@ fn search_profile<F: Fn(&VoltageInput) -> f64 + Sync>(
     Ok((profile, values, input, c))
 }
 
-/// The fixed experiments: each profile at the model's U, or for a current command at the
-/// largest current within the current limit at which every candidate stays within the speed
-/// limit (the strongest such experiment the drive allows; a constant load can make that zero).
+/// The fixed experiments: each profile at the model's U, or for a drive at the largest level
+/// (current, or reference speed) within its limit at which every candidate stays within the
+/// limits (the strongest such experiment the drive allows; a constant load can make that zero).
 /// (name, input).
 fn fixed_inputs(
     experiment: &Experiment,
@@ -280,11 +286,11 @@ fn fixed_inputs(
                 .candidates
                 .first()
                 .map_or(0.0, |c| c.problem.model.motor.voltage),
-            Commanded::Current => {
+            commanded @ (Commanded::Current | Commanded::Position) => {
                 let within = |u: f64| -> Result<bool, Error> {
                     Ok(check(experiment, p.name(), &at(p, u), limits)?.within_limits)
                 };
-                let mut high = limits.current;
+                let mut high = commanded.level_limit(limits)?;
                 let mut low = 0.0;
                 if within(high)? {
                     low = high;
@@ -308,7 +314,7 @@ fn fixed_inputs(
     Ok(out)
 }
 
-/// For a current command, the fixed experiments as search starts, at the largest level within
+/// For a drive's command, the fixed experiments as search starts, at the largest level within
 /// the search's (tightened) limits: each is then a feasible start, and the designed input's
 /// noise-free objective is at least theirs (the search keeps its best point). Run at the
 /// limits, they are strong: the seeded starts alone were seen to end far below the reversal
@@ -320,7 +326,7 @@ fn fixed_starts(
     search_limits: &Limits,
     segments: usize,
 ) -> Result<Vec<Profile>, Error> {
-    if experiment.commanded()? != Commanded::Current {
+    if !experiment.commanded()?.is_sampled() {
         return Ok(Vec::new());
     }
     let duration = *experiment.times.last().unwrap_or(&0.0);

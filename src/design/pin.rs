@@ -219,7 +219,7 @@ pub fn pin_cost(
     forward
         .simulate(&candidate.theta, &mut y)
         .map_err(|e| Error::Numerical(e.to_string()))?;
-    let excess = limits.excess(forward.channels(), &y);
+    let excess = limits.excess(forward.channels(), &y, &experiment.times);
     if excess > 0.0 {
         return Ok(Err(excess));
     }

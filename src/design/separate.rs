@@ -68,7 +68,7 @@ pub fn predictions(
         let forward = c.forward(input, &experiment.times)?;
         let mut y = vec![0.0; forward.n_outputs()];
         forward.simulate(&c.theta, &mut y).map_err(numerical)?;
-        excess += limits.excess(forward.channels(), &y);
+        excess += limits.excess(forward.channels(), &y, &experiment.times);
         out.push(y);
     }
     Ok((out, excess))
@@ -287,12 +287,7 @@ pub struct LeadCurves {
 }
 
 pub fn lead_curves(experiment: &Experiment, input: &VoltageInput) -> Result<LeadCurves, Error> {
-    let open = Limits {
-        voltage: f64::INFINITY,
-        current: f64::INFINITY,
-        speed: f64::INFINITY,
-    };
-    let evaluation = noise_free_leads(experiment, input, &open, true)?;
+    let evaluation = noise_free_leads(experiment, input, &Limits::open(), true)?;
     let Evaluation::Feasible { leads, fits } = evaluation else {
         return Err(Error::invalid("no limits to pass"));
     };

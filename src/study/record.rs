@@ -1,6 +1,7 @@
 //! A synthetic record driven by an input held between its samples: the voltage of the
-//! voltage-driven motor, or the current a `current_driven` drive is commanded (what `design`
-//! writes to `input.csv` and `simulate --input FILE` plays back).
+//! voltage-driven motor, the current a `current_driven` drive is commanded, or the reference
+//! position of a `position_loop` (what `design` writes to `input.csv` and `simulate --input
+//! FILE` plays back).
 
 use crate::error::Error;
 use crate::io::{ModelFile, Recording};
@@ -9,25 +10,22 @@ use crate::synthetic::{SyntheticData, generate};
 
 use super::recording_from;
 
-/// The column of an input file that drives a model of `base`: `U`, or `I` for a current-driven
-/// model. A `position_loop` model is refused: its input is a reference position fed through its
-/// controller, not a series to play back.
+/// The column of an input file that drives a model of `base`: `U`, `I` for a current-driven
+/// model, `q_ref` for a position loop.
 pub fn input_column(base: Base) -> Result<&'static str, Error> {
-    match base {
-        Base::VoltageDriven => Ok("U"),
-        Base::CurrentDriven => Ok("I"),
-        Base::PositionLoop => Err(Error::invalid(
-            "a position_loop model is driven by a reference position through its controller; \
-             only a voltage (t,U) or a current command (t,I, current_driven) can be played back",
-        )),
-    }
+    Ok(match base {
+        Base::VoltageDriven => "U",
+        Base::CurrentDriven => "I",
+        Base::PositionLoop => "q_ref",
+    })
 }
 
 /// The record `file`'s model makes under `values` held from each of `times` on, with noise
-/// σ = `noise_sd` — given as (σ_I, σ_ω), each channel the model measures taking its own (a
-/// current-driven model measures ω alone: its current is the input, recorded as given). The
-/// recording carries the input as its `U` column, or as the input `I` of a current-driven
-/// record.
+/// σ = `noise_sd`: two numbers, the first σ_I or σ_q, the second σ_ω or σ_force, each channel
+/// the model measures taking its own (a current-driven model measures ω alone, with the second;
+/// its current is the input, recorded as given). The recording carries the input as its `U`
+/// column, as the input `I` of a current-driven record, or as the reference `q_ref` of a
+/// position loop, whose axis starts at rest at the reference's first value.
 pub fn held_input_record(
     file: &ModelFile,
     times: &[f64],
@@ -37,32 +35,43 @@ pub fn held_input_record(
     source: &str,
 ) -> Result<(Recording, SyntheticData), Error> {
     let numerical = |e: crate::ode::OdeError| Error::Numerical(e.to_string());
-    input_column(file.base)?;
-    match file.base {
-        Base::CurrentDriven => {
-            let input = Recording {
-                source: source.into(),
-                time: times.to_vec(),
-                channels: vec![("omega".into(), vec![0.0; times.len()])],
-                voltage: None,
-                inputs: vec![("I".into(), values)],
-            };
-            let model = file.model_for_recording(&input).map_err(Error::invalid)?;
-            let data = generate(&model, times, &[noise_sd[1]], seed).map_err(numerical)?;
-            let recording = Recording {
-                inputs: input.inputs,
-                ..recording_from(&data, source, None)
-            };
-            Ok((recording, data))
-        }
-        _ => {
+    let m = times.len();
+    let (channels, inputs, sd) = match file.base {
+        Base::VoltageDriven => {
             let input = VoltageInput::Held {
                 times: times.to_vec(),
                 values,
             };
-            voltage_record(file, times, input, noise_sd, seed, source)
+            return voltage_record(file, times, input, noise_sd, seed, source);
         }
-    }
+        Base::CurrentDriven => (
+            vec![("omega".into(), vec![0.0; m])],
+            vec![("I".into(), values)],
+            vec![noise_sd[1]],
+        ),
+        Base::PositionLoop => {
+            let start = values.first().copied().unwrap_or(0.0);
+            (
+                vec![("q".into(), vec![start; m]), ("force".into(), vec![0.0; m])],
+                vec![("q_ref".into(), values)],
+                noise_sd.to_vec(),
+            )
+        }
+    };
+    let input = Recording {
+        source: source.into(),
+        time: times.to_vec(),
+        channels,
+        voltage: None,
+        inputs,
+    };
+    let model = file.model_for_recording(&input).map_err(Error::invalid)?;
+    let data = generate(&model, times, &sd, seed).map_err(numerical)?;
+    let recording = Recording {
+        inputs: input.inputs,
+        ..recording_from(&data, source, None)
+    };
+    Ok((recording, data))
 }
 
 /// The record `file`'s voltage-driven model makes under `input` (a held voltage, or constant at

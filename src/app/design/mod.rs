@@ -19,6 +19,9 @@ use crate::study::Problem;
 
 use super::AppError;
 
+mod print;
+use print::print_summary;
+
 // The options of `motorcal design`, as the command line and the tests give them.
 #[derive(clap::Args, Clone, Debug)]
 pub struct DesignArgs {
@@ -45,21 +48,24 @@ pub struct DesignArgs {
     #[arg(long)]
     pub rate: f64,
     /// The drive's limits, e.g. U=±24,I=±300,omega=±3000 (a current_driven model: I=±6,omega=±500,
-    /// the current being what it commands).
+    /// the current being what it commands; a position_loop: q=±0.1,omega=±0.5, the reference's
+    /// travel about q = 0 and the axis's speed, and optionally force=±F to keep the controller
+    /// below its saturation).
     #[arg(long, allow_hyphen_values = true)]
     pub limits: String,
-    /// Segments of the designed input (a voltage, or a current_driven model's current command).
+    /// Segments of the designed input (a voltage, a current_driven model's current command, or
+    /// a position_loop's reference position).
     #[arg(long, default_value_t = 8)]
     pub segments: usize,
     #[arg(long, default_value_t = 2026)]
     pub seed: u64,
-    /// Noise σ of each channel the model measures: I [A] and ω [rad/s], or ω alone for a
-    /// current_driven model (default: the diagnosis's or the fitted recording's, else the
-    /// paper's 2 and 10).
-    #[arg(long, num_args = 1..=2, value_names = ["SD_I", "SD_OMEGA"])]
+    /// Noise σ of each channel the model measures: I [A] and ω [rad/s], ω alone for a
+    /// current_driven model, q and the force for a position_loop (default: the diagnosis's or
+    /// the fitted recording's, else the paper's 2 and 10; a position_loop has no default).
+    #[arg(long, num_args = 1..=2, value_names = ["SD_1", "SD_2"])]
     pub noise_sd: Option<Vec<f64>>,
-    /// Seeded search starts (run in parallel; a current_driven design also starts from its
-    /// fixed experiments).
+    /// Seeded search starts (run in parallel; a drive's design also starts from its fixed
+    /// experiments).
     #[arg(long, default_value_t = 4)]
     pub starts: usize,
     /// Noisy records per candidate for the reported gap and its spread.
@@ -267,7 +273,11 @@ pub fn run(args: &DesignArgs) -> Result<(), AppError> {
     report["rate_hz"] = json!(args.rate);
     report["segments"] = json!(args.segments);
     report["noise_sd"] = json!(channels.iter().zip(&noise_sd).collect::<BTreeMap<_, _>>());
-    report["input"] = json!({"quantity": commanded.column(), "unit": commanded.unit()});
+    let (level, level_unit) = commanded.level();
+    report["input"] = json!({
+        "quantity": commanded.column(), "unit": commanded.unit(),
+        "levels": {"quantity": level, "unit": level_unit},
+    });
     report["search"] = json!(settings.search);
     report["draws"] = json!(settings.draws);
     report["runtime_s"] = json!(started.elapsed().as_secs_f64());
@@ -281,6 +291,8 @@ pub fn run(args: &DesignArgs) -> Result<(), AppError> {
         .iter()
         .map(|&c| (c, model.base.channel_unit(c)))
         .collect::<Vec<_>>();
+    // What the drive is played: the levels, or a position loop's reference, their integral.
+    let values = commanded.played(&times, &values);
     let written = Written {
         times: &times,
         values: &values,
@@ -336,11 +348,20 @@ fn read_diagnosis(path: &Path) -> Result<Value, AppError> {
     Ok(value)
 }
 
-/// The selected term and its ties.
+/// The selected term and its ties, and the pairs a drive's records cannot tell apart
+/// (`tied_pairs`: Coulomb friction and a load on records that never reverse).
 fn default_candidates(diagnosis: &Value) -> Result<Vec<String>, AppError> {
     let mut names = vec![diagnosis["selected"].as_str().unwrap_or("none").to_string()];
-    for tie in diagnosis["ties"].as_array().into_iter().flatten() {
-        if let Some(t) = tie.as_str() {
+    let ties = diagnosis["ties"].as_array().into_iter().flatten();
+    let pairs = diagnosis["tied_pairs"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .flat_map(|pair| pair.as_array().into_iter().flatten());
+    for tie in ties.chain(pairs) {
+        if let Some(t) = tie.as_str()
+            && !names.iter().any(|n| n == t)
+        {
             names.push(t.to_string());
         }
     }
@@ -404,10 +425,18 @@ fn noise_sd(
             return Ok(sd);
         }
     }
-    Ok(channels
+    channels
         .iter()
-        .map(|c| design::default_noise_sd(c))
-        .collect())
+        .map(|c| {
+            design::default_noise_sd(c).ok_or_else(|| {
+                AppError::Usage(format!(
+                    "--noise-sd: no σ for the channel '{c}' (the model measures {}): give \
+                     --noise-sd, or --diagnosis or --data to take it from",
+                    channels.join(", ")
+                ))
+            })
+        })
+        .collect()
 }
 
 /// What input.csv and design.png show: the sample times, the designed levels, the input's
@@ -473,121 +502,4 @@ fn write_outputs(
     )
     .map_err(|e| AppError::Output(e.to_string()))?;
     Ok(())
-}
-
-/// The rival check: each round's candidates, gap and unseparated rivals, then what is left.
-fn print_rivals(report: &Value) {
-    let check = &report["rival_check"];
-    if check.is_null() {
-        println!("rest of the library: not checked (--no-rival-check)");
-        return;
-    }
-    let threshold = check["threshold_nats"].as_f64().unwrap_or(f64::NAN);
-    let rounds = check["rounds"].as_array().map_or(&[][..], Vec::as_slice);
-    for (i, round) in rounds.iter().enumerate() {
-        let names: Vec<&str> = round["candidates"]
-            .as_array()
-            .into_iter()
-            .flatten()
-            .filter_map(Value::as_str)
-            .collect();
-        let rivals: Vec<String> = round["unseparated_rivals"]
-            .as_array()
-            .into_iter()
-            .flatten()
-            .map(|r| {
-                format!(
-                    "{} on {} ({:.2})",
-                    r["rival"].as_str().unwrap_or(""),
-                    r["truth"].as_str().unwrap_or(""),
-                    r["expected_gap_nats"].as_f64().unwrap_or(f64::NAN)
-                )
-            })
-            .collect();
-        println!(
-            "  round {}: {} → expected gap {:.2} nats; rivals within {threshold} nats: {}",
-            i + 1,
-            names.join(", "),
-            round["expected_gap_nats"].as_f64().unwrap_or(f64::NAN),
-            if rivals.is_empty() {
-                "none".into()
-            } else {
-                rivals.join(", ")
-            }
-        );
-        if let Some(note) = round["note"].as_str() {
-            println!("    {note}");
-        }
-    }
-    let rivals = report["unseparated_rivals"]
-        .as_array()
-        .map_or(&[][..], Vec::as_slice);
-    if rivals.is_empty() {
-        println!("rest of the library: no rival within {threshold} nats of any candidate");
-    } else {
-        println!("unseparated rivals (the design leaves them within {threshold} nats):");
-        println!("  {:<24} {:<24} {:>16}", "truth", "rival", "expected gap");
-        for r in rivals {
-            println!(
-                "  {:<24} {:<24} {:>16.2}",
-                r["truth"].as_str().unwrap_or(""),
-                r["rival"].as_str().unwrap_or(""),
-                r["expected_gap_nats"].as_f64().unwrap_or(f64::NAN)
-            );
-        }
-    }
-}
-
-fn print_summary(report: &Value, out: &Path) {
-    let f = |v: &Value| v.as_f64().map_or("—".to_string(), |x| format!("{x:.2}"));
-    if report["objective"] == "separate" {
-        println!(
-            "designed input: expected gap {} ± {} nats (worst truth)",
-            f(&report["expected_gap_nats"]),
-            f(&report["expected_gap_sd_nats"])
-        );
-        for g in report["gaps"].as_array().into_iter().flatten() {
-            println!(
-                "  {} as truth over {}: {} ± {} nats (noise-free {})",
-                g["truth"].as_str().unwrap_or(""),
-                g["rival"].as_str().unwrap_or(""),
-                f(&g["expected_gap_nats"]),
-                f(&g["sd_nats"]),
-                f(&g["noise_free_gap_nats"])
-            );
-        }
-        print_rivals(report);
-        for e in report["fixed_experiments"].as_array().into_iter().flatten() {
-            println!(
-                "{:>9} input: expected gap {} ± {} nats{}",
-                e["input"].as_str().unwrap_or(""),
-                f(&e["expected_gap_nats"]),
-                f(&e["expected_gap_sd_nats"]),
-                if e["within_limits"] == true {
-                    ""
-                } else {
-                    " (passes the limits)"
-                }
-            );
-        }
-    } else {
-        println!("designed input: expected sd {}", report["expected_sd"]);
-        for e in report["fixed_experiments"].as_array().into_iter().flatten() {
-            println!(
-                "{:>9} input: expected sd {}{}",
-                e["input"].as_str().unwrap_or(""),
-                e["expected_sd"],
-                if e["within_limits"] == true {
-                    ""
-                } else {
-                    " (passes the limits)"
-                }
-            );
-        }
-    }
-    println!(
-        "wrote {} (input.csv, design.json, design.png) in {:.1} s",
-        out.display(),
-        report["runtime_s"].as_f64().unwrap_or(0.0)
-    );
 }
