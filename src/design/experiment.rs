@@ -184,6 +184,22 @@ pub fn design_times(duration: f64, rate: f64) -> Result<Vec<f64>, Error> {
     Ok((1..=m).map(|i| i as f64 / rate).collect())
 }
 
+/// The limits a design of `model` keeps: as given, and for a position loop given no force limit
+/// 2% ([`super::MARGIN`]) under the force its controller saturates at (c_g times
+/// `drive.input_limit`), so that neither the design nor the fixed experiments it is compared
+/// with drive the loop into its saturation: there the axis's position depends on the model
+/// through switching instants that the fits of `diagnose` then lose (papers/design.md: 2 and 11
+/// of 20 records named so).
+pub fn model_limits(model: &crate::io::ModelFile, limits: Limits) -> Limits {
+    match (model.base, model.drive.input_limit) {
+        (Base::PositionLoop, Some(saturation)) if !limits.force.is_finite() => Limits {
+            force: super::MARGIN * model.motor.torque_constant * saturation,
+            ..limits
+        },
+        _ => limits,
+    }
+}
+
 /// The user's model on the design's sampling: a problem whose one record is a placeholder at
 /// `times` (no data of it is fitted). A drive reads its scales from that record (the largest
 /// input it is commanded, the largest speed it reaches: what a term's default smoothing speed
@@ -401,5 +417,24 @@ mod tests {
         // The other inputs are played as designed.
         assert_eq!(Commanded::Current.played(&times, &speeds), speeds);
         assert_eq!(Commanded::Position.level(), ("reference speed", "m/s"));
+    }
+
+    #[test]
+    fn a_position_loop_s_force_is_limited_to_its_saturation_unless_told() {
+        let mut model = crate::io::ModelFile {
+            base: Base::PositionLoop,
+            ..Default::default()
+        };
+        model.motor.torque_constant = 35.0;
+        model.drive.input_limit = Some(10.0);
+        let given: Limits = "q=±0.1,omega=±0.5".parse().unwrap();
+        assert_eq!(
+            model_limits(&model, given).force,
+            super::super::MARGIN * 350.0
+        );
+        let held: Limits = "q=±0.1,omega=±0.5,force=±300".parse().unwrap();
+        assert_eq!(model_limits(&model, held).force, 300.0);
+        model.base = Base::CurrentDriven;
+        assert_eq!(model_limits(&model, given).force, f64::INFINITY);
     }
 }

@@ -35,7 +35,7 @@ mod search;
 mod separate;
 
 pub use experiment::{
-    Candidate, Commanded, Experiment, default_noise_sd, design_problem, design_times,
+    Candidate, Commanded, Experiment, default_noise_sd, design_problem, design_times, model_limits,
     parse_candidate,
 };
 pub use fitted::candidates_without_diagnosis;

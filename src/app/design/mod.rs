@@ -49,8 +49,8 @@ pub struct DesignArgs {
     pub rate: f64,
     /// The drive's limits, e.g. U=±24,I=±300,omega=±3000 (a current_driven model: I=±6,omega=±500,
     /// the current being what it commands; a position_loop: q=±0.1,omega=±0.5, the reference's
-    /// travel about q = 0 and the axis's speed, and optionally force=±F to keep the controller
-    /// below its saturation).
+    /// travel about q = 0 and the axis's speed, and force=±F, by default 2% under the
+    /// controller's saturation).
     #[arg(long, allow_hyphen_values = true)]
     pub limits: String,
     /// Segments of the designed input (a voltage, a current_driven model's current command, or
@@ -90,6 +90,7 @@ pub fn run(args: &DesignArgs) -> Result<(), AppError> {
         .parse()
         .map_err(|e| AppError::Usage(format!("--limits {}: {e}", args.limits)))?;
     let model = read_model_file(&args.model)?;
+    let limits = design::model_limits(&model, limits);
     let times = design_times(args.duration, args.rate)?;
     let base = design_problem(&model, &times, &limits)?;
     let commanded = design::Commanded::of(model.base)?;
