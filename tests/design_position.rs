@@ -21,7 +21,7 @@ fn model_path() -> PathBuf {
 
 const LIMITS: &str = "q=±0.1,omega=±0.5,force=±300";
 /// σ of q [m] and of the force [N]: EMPS's after its fit are about 2 µm and 3 N.
-const NOISE: [&str; 2] = ["1e-5", "5"];
+const NOISE: [&str; 2] = ["2e-6", "5"];
 
 fn run(args: &[&str]) -> String {
     let o = motorcal(args);
