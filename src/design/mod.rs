@@ -1,6 +1,6 @@
 //! `motorcal design`: the input to record next. Within the drive's limits, a piecewise-constant
 //! voltage of N segments — for a `current_driven` model a current command, for a
-//! `position_loop` a reference position ([`Commanded`]) —
+//! `position_loop` the speed of a reference position ([`Commanded`]) —
 //! that either tells candidate explanations apart (the expected evidence gap of each candidate
 //! as the truth over its best-fitting rival, [`separate`]) or pins named parameters (D-optimal
 //! on the Fisher matrix of the forward sensitivities, [`pin`]); beside it the fixed experiments
@@ -15,11 +15,11 @@
 //! design's input, and the redesign with the rivals it finds). Nothing here reads or writes a file: `app::design` does.
 //!
 //! **Limits.** An input is judged on the noise-free predictions of every candidate at the
-//! record's samples: one whose |I|, |ω| or a position loop's |q| passes its limit there is
-//! refused (a position loop's speed is its position's difference between samples). The search
-//! runs on the continuous switching times with the current, speed and travel limits 2% tighter
-//! ([`MARGIN`]), a reference's speeds too, since the axis follows them;
-//! the input written switches at the first sample at or after each switching time, and is
+//! record's samples: one whose |I|, |ω| or a position loop's |q| or force passes its limit
+//! there is refused (a position loop's speed is its position's difference between samples). The
+//! search runs on the continuous switching times with the current, speed, travel and force
+//! limits 2% tighter ([`MARGIN`]), a reference's speeds too, since the axis follows them; the
+//! input written switches at the first sample at or after each switching time, and is
 //! checked again against the limits themselves — an input that then passes one is an error,
 //! never clipped. A drive is integrated at its samples with its input held over each sample
 //! interval ([`crate::motor::SampledDrive`]): its search sees a switch at the first sample at or
@@ -56,7 +56,8 @@ use crate::error::Error;
 use crate::motor::VoltageInput;
 use crate::study::InputProfile;
 
-/// The search keeps |I|, |ω| and |q| this fraction inside their limits (see the module's notes).
+/// The search keeps |I|, |ω|, |q| and a position loop's force this fraction inside their
+/// limits (see the module's notes).
 pub const MARGIN: f64 = 0.98;
 
 /// Monte Carlo records per truth for a reported gap.
@@ -99,7 +100,8 @@ pub struct FixedSeparation {
 pub struct SeparationDesign {
     pub profile: Profile,
     pub times: Vec<f64>,
-    /// The voltage (a drive: the current or the reference) at each sample time: `input.csv`.
+    /// The level at each sample time: the voltage, a current command, or a reference's speed
+    /// (`input.csv` holds what the drive is played: [`Commanded::played`]).
     pub values: Vec<f64>,
     pub check: InputCheck,
     /// The smallest expected gap over the truths (the design's guarantee), its truth's sd.
