@@ -106,6 +106,37 @@ fn a_designed_reference_parts_coulomb_friction_from_a_load_and_the_loop_closes()
         diagnosis["ranking"]
     );
 
+    // Without a diagnosis, the candidates fitted to the record give σ, which a position loop
+    // has no default for.
+    let fitted = dir.join("fitted");
+    run(&[
+        "design",
+        "--model",
+        model_path().to_str().unwrap(),
+        "--data",
+        recorded.to_str().unwrap(),
+        "--separate",
+        "coulomb_friction,load_torque",
+        "--duration",
+        "0.2",
+        "--rate",
+        "1000",
+        "--limits",
+        LIMITS,
+        "--starts",
+        "1",
+        "--draws",
+        "2",
+        "--no-rival-check",
+        "--out",
+        fitted.to_str().unwrap(),
+    ]);
+    let sd = json(&fitted.join("design.json"))["noise_sd"].clone();
+    let sd_q = sd["q"].as_f64().unwrap();
+    let sd_force = sd["force"].as_f64().unwrap();
+    assert!((sd_q / 2e-6 - 1.0).abs() < 0.2, "σ_q {sd_q}");
+    assert!((sd_force / 5.0 - 1.0).abs() < 0.2, "σ_force {sd_force}");
+
     let out = dir.join("design");
     let diagnosis_path = dir.join("ramp.json");
     run(&[

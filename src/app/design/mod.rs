@@ -429,13 +429,19 @@ fn noise_sd(
     channels
         .iter()
         .map(|c| {
-            design::default_noise_sd(c).ok_or_else(|| {
-                AppError::Usage(format!(
-                    "--noise-sd: no σ for the channel '{c}' (the model measures {}): give \
+            // Candidates fitted to --data take σ from their best fit (`run`), before anything
+            // uses it: a channel without a default needs none then.
+            let fitted_later =
+                args.pin.is_none() && args.diagnosis.is_none() && !args.data.is_empty();
+            design::default_noise_sd(c)
+                .or(fitted_later.then_some(1.0))
+                .ok_or_else(|| {
+                    AppError::Usage(format!(
+                        "--noise-sd: no σ for the channel '{c}' (the model measures {}): give \
                      --noise-sd, or --diagnosis or --data to take it from",
-                    channels.join(", ")
-                ))
-            })
+                        channels.join(", ")
+                    ))
+                })
         })
         .collect()
 }
