@@ -241,8 +241,7 @@ pub fn simulate(options: &SimulateOptions) -> Result<SimulateReport, AppError> {
                     path.display()
                 )));
             }
-            let column = crate::study::input_column(truth_file.base).map_err(truth_error)?;
-            let profile = read_input_profile(path, column)?;
+            let profile = read_input_profile(path, truth_file.base.input())?;
             crate::study::held_input_record(
                 &truth_file,
                 &profile.times,
@@ -260,7 +259,7 @@ pub fn simulate(options: &SimulateOptions) -> Result<SimulateReport, AppError> {
                      t,{} file",
                     profile.name(),
                     truth_file.base.name(),
-                    crate::study::input_column(truth_file.base).map_err(truth_error)?
+                    truth_file.base.input()
                 )));
             }
             let samples = options.samples.unwrap_or(DEFAULT_SAMPLES);

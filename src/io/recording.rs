@@ -200,11 +200,14 @@ fn roles(map: &ChannelMap, base: Base) -> Roles {
             .collect(),
         inputs: match base {
             // A voltage column the user named must exist; the default `U` may be absent.
-            Base::VoltageDriven => vec![input("U", map.voltage != ChannelMap::default().voltage)],
-            Base::CurrentDriven => vec![input("I", true)],
+            Base::VoltageDriven => vec![input(
+                base.input(),
+                map.voltage != ChannelMap::default().voltage,
+            )],
+            Base::CurrentDriven => vec![input(base.input(), true)],
             // The disturbance is absent from ordinary records of a rig whose validation record
             // has it: 0 then, not an error.
-            Base::PositionLoop => vec![input("q_ref", true), input("disturbance", false)],
+            Base::PositionLoop => vec![input(base.input(), true), input("disturbance", false)],
         },
     }
 }

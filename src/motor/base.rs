@@ -93,4 +93,15 @@ impl Base {
             Base::PositionLoop => &POSITION_LOOP_CHANNELS,
         }
     }
+
+    /// The recorded input that drives the base: the voltage `U`, the current `I` a drive is
+    /// commanded, or a position loop's reference `q_ref` (what a record carries, an input file
+    /// plays back and `design` writes).
+    pub fn input(&self) -> &'static str {
+        match self {
+            Base::VoltageDriven => "U",
+            Base::CurrentDriven => "I",
+            Base::PositionLoop => "q_ref",
+        }
+    }
 }

@@ -17,4 +17,4 @@ pub use inputs::InputProfile;
 pub use predict::{ChannelResidual, RecordPrediction, predict_records, residuals};
 pub use predictive::{ChannelPredictive, Predictive, posterior_predictive, replicated_recordings};
 pub use problem::{BOUNDED_STARTS, Problem, Reference, recording_from};
-pub use record::{held_input_record, input_column, voltage_record};
+pub use record::{held_input_record, voltage_record};

@@ -10,16 +10,6 @@ use crate::synthetic::{SyntheticData, generate};
 
 use super::recording_from;
 
-/// The column of an input file that drives a model of `base`: `U`, `I` for a current-driven
-/// model, `q_ref` for a position loop.
-pub fn input_column(base: Base) -> Result<&'static str, Error> {
-    Ok(match base {
-        Base::VoltageDriven => "U",
-        Base::CurrentDriven => "I",
-        Base::PositionLoop => "q_ref",
-    })
-}
-
 /// The record `file`'s model makes under `values` held from each of `times` on, with noise
 /// σ = `noise_sd`: two numbers, the first σ_I or σ_q, the second σ_ω or σ_force, each channel
 /// the model measures taking its own (a current-driven model measures ω alone, with the second;
