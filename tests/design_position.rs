@@ -71,6 +71,26 @@ fn simulate(truth: &Path, input: &Path, noise: [&str; 2], seed: &str, out: &Path
     out.join("recording.csv")
 }
 
+/// `design --model model --limits limits REST --out out`.
+fn design(model: &Path, limits: &str, rest: &[&str], out: &Path) -> std::process::Output {
+    let mut args = vec![
+        "design",
+        "--model",
+        model.to_str().unwrap(),
+        "--limits",
+        limits,
+    ];
+    args.extend_from_slice(rest);
+    args.extend(["--out", out.to_str().unwrap()]);
+    motorcal(&args)
+}
+
+/// `design` on the fixture, which must succeed.
+fn design_fixture(rest: &[&str], out: &Path) {
+    let o = design(&model_path(), LIMITS, rest, out);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
 fn diagnose(recording: &Path, report: &Path) -> serde_json::Value {
     run(&[
         "diagnose",
@@ -109,28 +129,24 @@ fn a_designed_reference_parts_coulomb_friction_from_a_load_and_the_loop_closes()
     // Without a diagnosis, the candidates fitted to the record give σ, which a position loop
     // has no default for.
     let fitted = dir.join("fitted");
-    run(&[
-        "design",
-        "--model",
-        model_path().to_str().unwrap(),
-        "--data",
-        recorded.to_str().unwrap(),
-        "--separate",
-        "coulomb_friction,load_torque",
-        "--duration",
-        "0.2",
-        "--rate",
-        "1000",
-        "--limits",
-        LIMITS,
-        "--starts",
-        "1",
-        "--draws",
-        "2",
-        "--no-rival-check",
-        "--out",
-        fitted.to_str().unwrap(),
-    ]);
+    design_fixture(
+        &[
+            "--data",
+            recorded.to_str().unwrap(),
+            "--separate",
+            "coulomb_friction,load_torque",
+            "--duration",
+            "0.2",
+            "--rate",
+            "1000",
+            "--starts",
+            "1",
+            "--draws",
+            "2",
+            "--no-rival-check",
+        ],
+        &fitted,
+    );
     let sd = json(&fitted.join("design.json"))["noise_sd"].clone();
     let sd_q = sd["q"].as_f64().unwrap();
     let sd_force = sd["force"].as_f64().unwrap();
@@ -139,24 +155,20 @@ fn a_designed_reference_parts_coulomb_friction_from_a_load_and_the_loop_closes()
 
     let out = dir.join("design");
     let diagnosis_path = dir.join("ramp.json");
-    run(&[
-        "design",
-        "--model",
-        model_path().to_str().unwrap(),
-        "--diagnosis",
-        diagnosis_path.to_str().unwrap(),
-        "--duration",
-        "1",
-        "--rate",
-        "1000",
-        "--limits",
-        LIMITS,
-        "--noise-sd",
-        NOISE[0],
-        NOISE[1],
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    design_fixture(
+        &[
+            "--diagnosis",
+            diagnosis_path.to_str().unwrap(),
+            "--duration",
+            "1",
+            "--rate",
+            "1000",
+            "--noise-sd",
+            NOISE[0],
+            NOISE[1],
+        ],
+        &out,
+    );
     let report = json(&out.join("design.json"));
     assert_eq!(
         report["candidates"],
@@ -250,29 +262,11 @@ fn a_designed_reference_parts_coulomb_friction_from_a_load_and_the_loop_closes()
 #[test]
 fn a_position_loop_design_needs_its_travel_and_speed_and_the_saturation() {
     let dir = scratch("design-position", "refused");
-    let design = |model: &Path, limits: &str, out: &Path| {
-        motorcal(&[
-            "design",
-            "--model",
-            model.to_str().unwrap(),
-            "--pin",
-            "J",
-            "--duration",
-            "0.05",
-            "--rate",
-            "400",
-            "--limits",
-            limits,
-            "--noise-sd",
-            NOISE[0],
-            NOISE[1],
-            "--out",
-            out.to_str().unwrap(),
-        ])
-    };
+    let pin = ["--pin", "J", "--duration", "0.05", "--rate", "400"];
+    let with_noise = [&pin[..], &["--noise-sd", NOISE[0], NOISE[1]]].concat();
     let out = dir.join("design");
     // A voltage's limits leave the travel out.
-    let o = design(&model_path(), "U=±24,I=±300,omega=±3000", &out);
+    let o = design(&model_path(), "U=±24,I=±300,omega=±3000", &with_noise, &out);
     one_error_line(
         &o,
         &[
@@ -289,25 +283,43 @@ fn a_position_loop_design_needs_its_travel_and_speed_and_the_saturation() {
         .replace("input_limit = 10.0\n", "");
     let unsaturated = dir.join("unsaturated.toml");
     std::fs::write(&unsaturated, text).unwrap();
-    let o = design(&unsaturated, LIMITS, &out);
+    let o = design(&unsaturated, LIMITS, &with_noise, &out);
     one_error_line(&o, &["drive.input_limit", "saturation"]);
     assert!(!out.exists());
     // Without σ for q and the force there is no default to fall back on.
-    let o = motorcal(&[
-        "design",
-        "--model",
-        model_path().to_str().unwrap(),
-        "--pin",
-        "J",
-        "--duration",
-        "0.05",
-        "--rate",
-        "400",
-        "--limits",
-        LIMITS,
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = design(&model_path(), LIMITS, &pin, &out);
     one_error_line(&o, &["--noise-sd", "'q'"]);
     assert!(!out.exists());
+}
+
+#[test]
+fn a_library_design_keeps_a_position_loop_under_its_saturation_unless_told() {
+    use motorcal::design::{self, DesignSettings, Experiment, SearchSettings, Target};
+    let model = motorcal::io::read_model_file(&model_path()).unwrap();
+    let times = design::design_times(0.2, 1000.0).unwrap();
+    // No force limit given: a caller of the library gets the command's default, 2% under
+    // the controller's saturation c_g·input_limit = 351.5 N.
+    let limits: design::Limits = "q=±0.1,omega=±0.5".parse().unwrap();
+    let base = design::design_problem(&model, &times, &limits).unwrap();
+    let targets = [Target::parse("J"), Target::parse("d")];
+    let candidate =
+        design::pin_candidate(&base, &std::collections::BTreeMap::new(), &targets).unwrap();
+    let experiment = Experiment {
+        candidates: vec![candidate.clone()],
+        times,
+        noise_sd: vec![2e-6, 5.0],
+    };
+    let settings = DesignSettings {
+        search: SearchSettings {
+            segments: 4,
+            starts: 1,
+            ..SearchSettings::default()
+        },
+        limits,
+        draws: 2,
+    };
+    let d = design::pin(&candidate, &experiment, &targets, &settings).unwrap();
+    let force = d.check.peaks["force"];
+    assert!(force <= design::MARGIN * 351.5, "|force| reaches {force} N");
+    assert!(d.check.within_limits);
 }

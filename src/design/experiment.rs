@@ -38,21 +38,26 @@ pub enum Commanded {
 
 impl Commanded {
     /// What a model of `base` is driven by.
-    pub fn of(base: Base) -> Result<Self, Error> {
-        Ok(match base {
+    pub fn of(base: Base) -> Self {
+        match base {
             Base::VoltageDriven => Commanded::Voltage,
             Base::CurrentDriven => Commanded::Current,
             Base::PositionLoop => Commanded::Position,
-        })
+        }
     }
 
-    /// The column of `input.csv`, what the drive is played (`U`, `I` or `q_ref`).
-    pub fn column(&self) -> &'static str {
+    /// The base a model so driven has.
+    fn base(&self) -> Base {
         match self {
-            Commanded::Voltage => "U",
-            Commanded::Current => "I",
-            Commanded::Position => "q_ref",
+            Commanded::Voltage => Base::VoltageDriven,
+            Commanded::Current => Base::CurrentDriven,
+            Commanded::Position => Base::PositionLoop,
         }
+    }
+
+    /// The column of `input.csv`, what the drive is played ([`Base::input`]).
+    pub fn column(&self) -> &'static str {
+        self.base().input()
     }
 
     pub fn unit(&self) -> &'static str {
@@ -90,8 +95,8 @@ impl Commanded {
     }
 
     /// The limits a design of this input needs: the level's own, and what the model measures
-    /// or moves at. A position loop's force needs none: its controller saturates
-    /// (`drive.input_limit`), and the speed is the axis's, from its position.
+    /// or moves at. A position loop's force needs none: it defaults to under the controller's
+    /// saturation ([`model_limits`]), and the speed is the axis's, from its position.
     pub fn required_limits(&self) -> &'static [&'static str] {
         match self {
             Commanded::Voltage => &["U", "I", "omega"],
@@ -129,7 +134,7 @@ impl Commanded {
     /// Whether the drive plays the levels sample by sample (the drive bases) rather than the
     /// integrator switching exactly at the switching times (the voltage).
     pub fn is_sampled(&self) -> bool {
-        *self != Commanded::Voltage
+        self.base().is_drive()
     }
 }
 
@@ -216,7 +221,7 @@ pub fn design_problem(
 ) -> Result<Problem, Error> {
     let m = times.len();
     let held = |v: f64| vec![if v.is_finite() { v } else { 0.0 }; m];
-    let commanded = Commanded::of(model.base)?;
+    let commanded = Commanded::of(model.base);
     commanded.check_limits(limits)?;
     let (channels, inputs) = match commanded {
         Commanded::Voltage => (
@@ -321,7 +326,7 @@ impl Candidate {
     /// record's, see [`design_problem`]); a position loop's axis starts at rest where its
     /// reference starts ([`Commanded::played`]).
     pub fn forward(&self, input: &VoltageInput, times: &[f64]) -> Result<ForwardModel, Error> {
-        let commanded = Commanded::of(self.problem.model.base)?;
+        let commanded = Commanded::of(self.problem.model.base);
         let model = match commanded {
             Commanded::Voltage => self
                 .problem
@@ -378,7 +383,7 @@ impl Experiment {
     }
 
     /// What the candidates are driven by.
-    pub fn commanded(&self) -> Result<Commanded, Error> {
+    pub fn commanded(&self) -> Commanded {
         Commanded::of(self.base())
     }
 

@@ -147,7 +147,7 @@ fn check(
         }
     }
     if let VoltageInput::Held { values, .. } = input {
-        let bound = experiment.commanded()?.level_limit(limits)?;
+        let bound = experiment.commanded().level_limit(limits)?;
         within &= values.iter().all(|u| u.abs() <= bound);
     }
     Ok(InputCheck {
@@ -177,7 +177,7 @@ fn check_possible(experiment: &Experiment, limits: &Limits) -> Result<(), Error>
             ),
         ));
     }
-    let commanded = experiment.commanded()?;
+    let commanded = experiment.commanded();
     let u = 0.01 * commanded.level_limit(limits)?;
     let input = held(&experiment.times, vec![u; experiment.times.len()]);
     let c = check(experiment, "probe", &input, limits)?;
@@ -200,6 +200,19 @@ fn check_possible(experiment: &Experiment, limits: &Limits) -> Result<(), Error>
         ));
     }
     Ok(())
+}
+
+/// `settings` with the limits the candidates' model keeps ([`model_limits`]: a position loop's
+/// force under its saturation unless given).
+fn with_model_limits(experiment: &Experiment, settings: &DesignSettings) -> DesignSettings {
+    let limits = match experiment.candidates.first() {
+        Some(c) => model_limits(&c.problem.model, settings.limits),
+        None => settings.limits,
+    };
+    DesignSettings {
+        limits,
+        ..*settings
+    }
 }
 
 fn tightened(limits: &Limits) -> Limits {
@@ -232,7 +245,7 @@ fn search_profile<F: Fn(&VoltageInput) -> f64 + Sync>(
         ));
     }
     // A reference's speeds keep the speed's margin: the axis follows them.
-    let commanded = experiment.commanded()?;
+    let commanded = experiment.commanded();
     let u_max = match commanded {
         Commanded::Position => commanded.level_limit(&tightened(&settings.limits))?,
         _ => commanded.level_limit(&settings.limits)?,
@@ -283,7 +296,7 @@ fn fixed_inputs(
     };
     let mut out = Vec::new();
     for p in profiles {
-        let u = match experiment.commanded()? {
+        let u = match experiment.commanded() {
             Commanded::Voltage => experiment
                 .candidates
                 .first()
@@ -328,7 +341,7 @@ fn fixed_starts(
     search_limits: &Limits,
     segments: usize,
 ) -> Result<Vec<Profile>, Error> {
-    if !experiment.commanded()?.is_sampled() {
+    if !experiment.commanded().is_sampled() {
         return Ok(Vec::new());
     }
     let duration = *experiment.times.last().unwrap_or(&0.0);
@@ -361,6 +374,7 @@ pub fn separate(
             "separating needs at least two candidates",
         ));
     }
+    let settings = &with_model_limits(experiment, settings);
     check_possible(experiment, &settings.limits)?;
     let search_limits = tightened(&settings.limits);
     let cost =
@@ -423,6 +437,7 @@ pub fn pin(
     targets: &[Target],
     settings: &DesignSettings,
 ) -> Result<PinDesign, Error> {
+    let settings = &with_model_limits(experiment, settings);
     check_possible(experiment, &settings.limits)?;
     let search_limits = tightened(&settings.limits);
     let cost = |input: &VoltageInput| match pin::pin_cost(

@@ -90,10 +90,11 @@ pub fn run(args: &DesignArgs) -> Result<(), AppError> {
         .parse()
         .map_err(|e| AppError::Usage(format!("--limits {}: {e}", args.limits)))?;
     let model = read_model_file(&args.model)?;
+    // As the design keeps them (it applies the same default): what design.json reports.
     let limits = design::model_limits(&model, limits);
     let times = design_times(args.duration, args.rate)?;
     let base = design_problem(&model, &times, &limits)?;
-    let commanded = design::Commanded::of(model.base)?;
+    let commanded = design::Commanded::of(model.base);
     let channels = model.base.channels();
     let diagnosis = args.diagnosis.as_deref().map(read_diagnosis).transpose()?;
     let mut noise_sd = noise_sd(args, diagnosis.as_ref(), channels)?;
@@ -426,13 +427,12 @@ fn noise_sd(
             return Ok(sd);
         }
     }
+    // Candidates fitted to --data take σ from their best fit (`run`), before anything uses it:
+    // a channel without a default needs none then.
+    let fitted_later = args.pin.is_none() && args.diagnosis.is_none() && !args.data.is_empty();
     channels
         .iter()
         .map(|c| {
-            // Candidates fitted to --data take σ from their best fit (`run`), before anything
-            // uses it: a channel without a default needs none then.
-            let fitted_later =
-                args.pin.is_none() && args.diagnosis.is_none() && !args.data.is_empty();
             design::default_noise_sd(c)
                 .or(fitted_later.then_some(1.0))
                 .ok_or_else(|| {
