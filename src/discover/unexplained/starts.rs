@@ -10,9 +10,51 @@ use crate::parameter::ParamId;
 
 use crate::study::Problem;
 
+use std::collections::BTreeMap;
+
 use super::super::candidate::Starts;
 use super::oscillation::frequency_search_cost;
 use super::{AsGiven, Fingerprint};
+use crate::study::frequency_grid::{grid_over, nyquist_over};
+
+/// The coupling's grid: frequencies a third of an octave apart (a resonance of ζ ≥ 0.05 is
+/// wider than that, so a grid point lies in its valley), damping ratios over the prior's
+/// range up to where it stops ringing, and shares of the inertia from barely felt to a third.
+const COUPLING_PER_OCTAVE: f64 = 3.0;
+const COUPLING_DAMPING: [f64; 3] = [0.05, 0.2, 0.5];
+const COUPLING_SHARES: [f64; 3] = [0.03, 0.1, 0.3];
+
+/// Points over the band a coupling's resonance can be resolved in on `problem`'s first record
+/// (`lowest` Hz up to half the Nyquist frequency, four samples a period), and how many of the
+/// verdict's frequencies lie in that band: what a frequency searched from them pays.
+fn coupling_grid(problem: &Problem, lowest: f64) -> (Vec<BTreeMap<String, f64>>, usize) {
+    let key = |p: &str| ParamId::of_term("compliant_coupling", p).to_string();
+    let Some(time) = problem.recordings.first().map(|r| &r.time) else {
+        return (Vec::new(), 0);
+    };
+    let span = time[time.len() - 1] - time[0];
+    let top = 0.5 * nyquist_over(span, time.len());
+    let mut points = Vec::new();
+    let mut f = lowest;
+    while f <= top {
+        for zeta in COUPLING_DAMPING {
+            for s in COUPLING_SHARES {
+                points.push(BTreeMap::from([
+                    (key("f_r"), f),
+                    (key("zeta"), zeta),
+                    (key("s"), s),
+                ]));
+            }
+        }
+        f *= 2f64.powf(1.0 / COUPLING_PER_OCTAVE);
+    }
+    let searched = grid_over(span, time.len())
+        .0
+        .iter()
+        .filter(|&&g| g <= top)
+        .count();
+    (points, searched)
+}
 
 /// The dynamic terms the starts are for.
 pub const DYNAMIC: [&str; 3] = ["input_delay", "sensor_lag", "compliant_coupling"];
@@ -23,6 +65,18 @@ pub fn dynamic_starts(problem: &Problem, as_given: &AsGiven, candidates: &[Strin
     let mut starts = Starts::default();
     if !candidates.iter().any(|c| DYNAMIC.contains(&c.as_str())) {
         return starts;
+    }
+    // The coupling's grid, whether or not the record rings: its frequency is then searched over
+    // the band and pays that search, as a ringing fingerprint's start pays the verdict's grid.
+    if candidates.iter().any(|c| c == "compliant_coupling") {
+        let (grid, searched) = coupling_grid(problem, as_given.lowest_frequency());
+        if !grid.is_empty() {
+            starts.grids.insert("compliant_coupling".into(), grid);
+            starts.search_penalty.insert(
+                "compliant_coupling".into(),
+                frequency_search_cost(searched, problem.n_observations()),
+            );
+        }
     }
     let Some(found) = as_given.scores(0.0).map(|s| s.fingerprints) else {
         return starts;
