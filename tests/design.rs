@@ -158,6 +158,17 @@ fn a_small_design_runs_end_to_end() {
         .map(|e| e["input"].as_str().unwrap())
         .collect();
     assert_eq!(fixed, ["reversal", "step"]);
+    // Each fixed experiment is written beside the design, to be recorded as it was scored:
+    // the same times, within the voltage limit, the reversal's voltage reversed.
+    for e in json["fixed_experiments"].as_array().unwrap() {
+        let file = e["file"].as_str().unwrap();
+        assert_eq!(file, format!("fixed-{}.csv", e["input"].as_str().unwrap()));
+        let played = read_voltage_profile(&out.join(file)).unwrap();
+        assert_eq!(played.times, input.times);
+        assert!(played.values.iter().all(|u| u.abs() <= 24.0), "{file}");
+    }
+    let reversal = read_voltage_profile(&out.join("fixed-reversal.csv")).unwrap();
+    assert!(reversal.values.first().unwrap() * reversal.values.last().unwrap() < 0.0);
     assert_eq!(json["seed"], 2026);
     assert_eq!(
         json["candidates"],

@@ -82,6 +82,10 @@ pub struct InputCheck {
     pub within_limits: bool,
     /// Peak |I| and |ω| (a position loop: |q| and the axis's |ω|) over the candidates.
     pub peaks: std::collections::BTreeMap<String, f64>,
+    /// The level at each of the experiment's times (what a fixed experiment's file holds, so
+    /// that it can be recorded too and its expected figures checked).
+    #[serde(skip)]
+    pub levels: Vec<f64>,
 }
 
 /// A fixed experiment's gaps, for comparison.
@@ -150,10 +154,20 @@ fn check(
         let bound = experiment.commanded().level_limit(limits)?;
         within &= values.iter().all(|u| u.abs() <= bound);
     }
+    let held_at = experiment
+        .candidates
+        .first()
+        .map_or(0.0, |c| c.problem.model.motor.voltage);
+    let levels = experiment
+        .times
+        .iter()
+        .map(|&t| input.value_at(t).unwrap_or(held_at))
+        .collect();
     Ok(InputCheck {
         input: name.into(),
         within_limits: within,
         peaks,
+        levels,
     })
 }
 

@@ -113,7 +113,9 @@ pub fn run(args: &DesignArgs) -> Result<(), AppError> {
             "--segments 0 : a design needs at least one".into(),
         ));
     }
-    let (report, values, figure) = if let Some(pins) = &args.pin {
+    let (report, values, fixed, figure): (_, _, Vec<design::InputCheck>, _) = if let Some(pins) =
+        &args.pin
+    {
         let targets: Vec<Target> = pins.iter().map(|p| Target::parse(p)).collect();
         let candidate = design::pin_candidate(&base, &BTreeMap::new(), &targets)?;
         let experiment = Experiment {
@@ -131,8 +133,8 @@ pub fn run(args: &DesignArgs) -> Result<(), AppError> {
             "expected_relative_sd": d.pinned.relative_sd,
             "log_det_covariance": d.pinned.log_det,
             "fixed_experiments": d.fixed_experiments.iter().map(|(c, p)| json!({
-                "input": c.input, "within_limits": c.within_limits, "peaks": c.peaks,
-                "expected_sd": p.sd, "expected_relative_sd": p.relative_sd,
+                "input": c.input, "file": fixed_file(&c.input), "within_limits": c.within_limits,
+                "peaks": c.peaks, "expected_sd": p.sd, "expected_relative_sd": p.relative_sd,
             })).collect::<Vec<_>>(),
             "profile": d.profile, "peaks": d.check.peaks,
         });
@@ -142,7 +144,8 @@ pub fn run(args: &DesignArgs) -> Result<(), AppError> {
             truth: y,
             rival: None,
         };
-        (report, d.values, figure)
+        let fixed = d.fixed_experiments.into_iter().map(|(c, _)| c).collect();
+        (report, d.values, fixed, figure)
     } else {
         let names = match (&args.separate, &diagnosis) {
             (Some(names), _) => names.clone(),
@@ -243,7 +246,8 @@ pub fn run(args: &DesignArgs) -> Result<(), AppError> {
             "expected_gap_sd_nats": d.spread_nats,
             "gaps": d.gaps,
             "fixed_experiments": d.fixed_experiments.iter().map(|f| json!({
-                "input": f.check.input, "expected_gap_nats": f.expected_gap_nats,
+                "input": f.check.input, "file": fixed_file(&f.check.input),
+                "expected_gap_nats": f.expected_gap_nats,
                 "expected_gap_sd_nats": f.spread_nats, "within_limits": f.check.within_limits,
                 "peaks": f.check.peaks, "gaps": f.gaps,
             })).collect::<Vec<_>>(),
@@ -266,7 +270,8 @@ pub fn run(args: &DesignArgs) -> Result<(), AppError> {
             truth: curves.truth,
             rival: Some((rival.clone(), curves.rival_fit)),
         };
-        (report, d.values, figure)
+        let fixed = d.fixed_experiments.into_iter().map(|f| f.check).collect();
+        (report, d.values, fixed, figure)
     };
     let mut report = report;
     report["limits"] = json!(limits);
@@ -295,9 +300,14 @@ pub fn run(args: &DesignArgs) -> Result<(), AppError> {
         .collect::<Vec<_>>();
     // What the drive is played: the levels, or a position loop's reference, their integral.
     let values = commanded.played(&times, &values);
+    let fixed: Vec<(String, Vec<f64>)> = fixed
+        .into_iter()
+        .map(|c| (fixed_file(&c.input), commanded.played(&times, &c.levels)))
+        .collect();
     let written = Written {
         times: &times,
         values: &values,
+        fixed: &fixed,
         input,
         channels: &channels,
         noise_sd: &noise_sd,
@@ -446,11 +456,19 @@ fn noise_sd(
         .collect()
 }
 
+/// The file a fixed experiment's input is written to in `--out`, beside the design's
+/// `input.csv`: the same columns, so that `simulate --input` and a rig take it alike.
+fn fixed_file(input: &str) -> String {
+    format!("fixed-{input}.csv")
+}
+
 /// What input.csv and design.png show: the sample times, the designed levels, the input's
 /// column and unit, the measured channels with their units and σ.
 struct Written<'a> {
     times: &'a [f64],
     values: &'a [f64],
+    /// Each fixed experiment's file name and what it plays, as `values` is the design's.
+    fixed: &'a [(String, Vec<f64>)],
     input: (&'a str, &'a str),
     channels: &'a [(&'a str, &'a str)],
     noise_sd: &'a [f64],
@@ -469,14 +487,22 @@ fn write_outputs(
         ..
     } = *written;
     std::fs::create_dir_all(out)?;
-    write_input_profile(
-        &out.join("input.csv"),
-        input.0,
-        &VoltageProfile {
-            times: times.to_vec(),
-            values: values.to_vec(),
-        },
-    )?;
+    let files = std::iter::once(("input.csv", values)).chain(
+        written
+            .fixed
+            .iter()
+            .map(|(name, played)| (name.as_str(), played.as_slice())),
+    );
+    for (name, played) in files {
+        write_input_profile(
+            &out.join(name),
+            input.0,
+            &VoltageProfile {
+                times: times.to_vec(),
+                values: played.to_vec(),
+            },
+        )?;
+    }
     let text = serde_json::to_string_pretty(report).map_err(|e| AppError::Output(e.to_string()))?;
     write_atomically(&out.join("design.json"), text.as_bytes())?;
     let m = times.len();
