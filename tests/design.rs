@@ -474,3 +474,54 @@ fn a_library_term_that_coincides_with_a_candidate_on_the_designed_input_is_found
     let omega = &y[times.len()..];
     assert!(omega.iter().any(|w| *w > 10.0) && omega.iter().any(|w| *w < -10.0));
 }
+
+/// `--pin` with `--data` designs where the recording puts the motor, not where the model file
+/// guessed: on a record of the paper's motor (c_g = 0.01) with the nominal model (c_g = 0.009),
+/// the design sits at the fit's c_g/J, 11% from the file's, and takes σ from that fit.
+#[test]
+fn a_pin_design_on_a_recording_sits_at_the_recording_s_estimates() {
+    let dir = scratch("design", "pin-data");
+    let sim = dir.join("sim");
+    let o = motorcal(&["simulate", "--seed", "5", "--out", sim.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let out = dir.join("design");
+    let o = motorcal(&[
+        "design",
+        "--model",
+        sim.join("motor.toml").to_str().unwrap(),
+        "--data",
+        sim.join("recording.csv").to_str().unwrap(),
+        "--pin",
+        "c_g/J",
+        "--duration",
+        "0.05",
+        "--rate",
+        "400",
+        "--limits",
+        "U=±24,I=±300,omega=±3000",
+        "--segments",
+        "3",
+        "--starts",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("design.json")).unwrap()).unwrap();
+    assert_eq!(
+        json["pinned_at"]["source"],
+        "the model's MAP on the recordings"
+    );
+    let at = &json["pinned_at"]["values"];
+    let ratio = at["c_g"].as_f64().unwrap() / at["J"].as_f64().unwrap();
+    assert!(
+        (ratio / (0.01 / 5e-5) - 1.0).abs() < 0.03,
+        "c_g/J {ratio} against the truth's 200 (the file's 180)"
+    );
+    let sd = [&json["noise_sd"]["I"], &json["noise_sd"]["omega"]].map(|s| s.as_f64().unwrap());
+    assert!(
+        (sd[0] / 2.0 - 1.0).abs() < 0.2 && (sd[1] / 10.0 - 1.0).abs() < 0.2,
+        "σ {sd:?} against the record's 2 and 10"
+    );
+}

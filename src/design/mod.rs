@@ -40,7 +40,7 @@ pub use experiment::{
 };
 pub use fitted::candidates_without_diagnosis;
 pub use limits::Limits;
-pub use pin::{Pinned, Target, fisher, pin_candidate, pinned};
+pub use pin::{Pinned, Target, fisher, pin_candidate, pin_values_from, pinned};
 pub use profile::{Profile, held};
 pub use rivals::{
     CheckedSeparation, RIVAL_ROUNDS, Rival, RivalCheck, RivalRound, check_rivals, library,

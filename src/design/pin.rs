@@ -57,6 +57,24 @@ pub fn pin_candidate(
     targets: &[Target],
 ) -> Result<Candidate, Error> {
     let mut problem = base.clone();
+    calibrate_targets(&mut problem, targets)?;
+    for (key, &v) in values {
+        problem.model.set_value(&ParamId::parse(key), v);
+    }
+    let calibrated = problem.calibrated_names()?;
+    let forward = problem.forward(crate::ode::SolverSettings::default())?;
+    Ok(Candidate {
+        name: "model".into(),
+        added: Vec::new(),
+        theta: forward.nominal_calibrated(),
+        calibrated,
+        problem,
+    })
+}
+
+/// `problem` with every parameter the targets name calibrated beside what it calibrates (R
+/// alone where it names nothing); a target the model has no parameter for is one error.
+fn calibrate_targets(problem: &mut Problem, targets: &[Target]) -> Result<(), Error> {
     let known = problem.model_for(problem.recording())?.parameter_names();
     let calibrate = problem.model.calibrate.get_or_insert_with(|| {
         vec![CalibrateEntry {
@@ -85,18 +103,21 @@ pub fn pin_candidate(
     if problem.model.schema < 2 {
         problem.model.schema = 2;
     }
-    for (key, &v) in values {
-        problem.model.set_value(&ParamId::parse(key), v);
-    }
-    let calibrated = problem.calibrated_names()?;
-    let forward = problem.forward(crate::ode::SolverSettings::default())?;
-    Ok(Candidate {
-        name: "model".into(),
-        added: Vec::new(),
-        theta: forward.nominal_calibrated(),
-        calibrated,
-        problem,
-    })
+    Ok(())
+}
+
+/// Where the recordings put the model: the MAP of BM1 on `recorded` (the model as given, the
+/// targets calibrated beside what it calibrates) and σ per channel from that fit. A design
+/// then pins the targets where the rig is, not where the model file guessed (its Fisher
+/// matrix depends on the values: c_g/J's sd on the speed the motor reaches).
+pub fn pin_values_from(
+    recorded: &Problem,
+    targets: &[Target],
+) -> Result<(BTreeMap<String, f64>, Vec<f64>), Error> {
+    let mut problem = recorded.clone();
+    calibrate_targets(&mut problem, targets)?;
+    let fit = crate::discover::fit_candidate(&problem, &[])?;
+    Ok((fit.theta.clone(), fit.noise_sd()))
 }
 
 /// Fᵢⱼ = Σᵣ wᵣ² Jᵣᵢ Jᵣⱼ at θ.

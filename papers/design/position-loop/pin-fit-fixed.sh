@@ -1,5 +1,5 @@
 #!/bin/sh
-# Session 17: the pinned sds of the fixed inputs (constant, reversal, step) confirmed by fits,
+# Session 18: the pinned sds of the fixed inputs (constant, reversal, step) confirmed by fits,
 # as pin-fit.sh confirms the designed input's. `design --pin J,d` as run.sh runs it, which now
 # writes each fixed experiment beside input.csv (fixed-<input>.csv, at the level it was scored
 # at); one record of each input (seed 9000, σ_q = 2 µm, σ_force = 5 N) is fitted by `motorcal

@@ -31,8 +31,8 @@ pub struct DesignArgs {
     /// A `diagnose --json` report: the candidates' fits and the noise σ.
     #[arg(long)]
     pub diagnosis: Option<PathBuf>,
-    /// Without --diagnosis: a recording to fit the --separate candidates to (repeat for
-    /// several); without either they sit at the model's values.
+    /// Without --diagnosis: a recording to fit the --separate candidates to, or with --pin the
+    /// model as given (repeat for several); without either they sit at the model's values.
     #[arg(long, conflicts_with = "diagnosis")]
     pub data: Vec<PathBuf>,
     /// Candidates to tell apart (default: the diagnosis's selected term and its ties).
@@ -117,7 +117,17 @@ pub fn run(args: &DesignArgs) -> Result<(), AppError> {
         &args.pin
     {
         let targets: Vec<Target> = pins.iter().map(|p| Target::parse(p)).collect();
-        let candidate = design::pin_candidate(&base, &BTreeMap::new(), &targets)?;
+        let (values, source) = if args.data.is_empty() {
+            (BTreeMap::new(), "the model's values")
+        } else {
+            let recorded = Problem::from_files(&args.data, &args.model)?;
+            let (values, sd) = design::pin_values_from(&recorded, &targets)?;
+            if args.noise_sd.is_none() {
+                noise_sd = sd;
+            }
+            (values, "the model's MAP on the recordings")
+        };
+        let candidate = design::pin_candidate(&base, &values, &targets)?;
         let experiment = Experiment {
             candidates: vec![candidate.clone()],
             times: times.clone(),
@@ -137,6 +147,8 @@ pub fn run(args: &DesignArgs) -> Result<(), AppError> {
                 "peaks": c.peaks, "expected_sd": p.sd, "expected_relative_sd": p.relative_sd,
             })).collect::<Vec<_>>(),
             "profile": d.profile, "peaks": d.check.peaks,
+            "pinned_at": {"source": source, "values": candidate.calibrated.iter()
+                .zip(&candidate.theta).collect::<BTreeMap<_, _>>()},
         });
         let figure = Figure {
             title: format!("design: pin {}", pins.join(", ")),
@@ -437,9 +449,9 @@ fn noise_sd(
             return Ok(sd);
         }
     }
-    // Candidates fitted to --data take σ from their best fit (`run`), before anything uses it:
-    // a channel without a default needs none then.
-    let fitted_later = args.pin.is_none() && args.diagnosis.is_none() && !args.data.is_empty();
+    // Candidates (or with --pin, the model) fitted to --data take σ from their best fit
+    // (`run`), before anything uses it: a channel without a default needs none then.
+    let fitted_later = args.diagnosis.is_none() && !args.data.is_empty();
     channels
         .iter()
         .map(|c| {
