@@ -525,3 +525,55 @@ fn a_pin_design_on_a_recording_sits_at_the_recording_s_estimates() {
         "σ {sd:?} against the record's 2 and 10"
     );
 }
+
+/// `--pin` with `--diagnosis` sits at the diagnosis's selected model at its MAP, so that a
+/// parameter of the term it found (the load torque of the fixture's diagnosis) can be pinned;
+/// the model as given alone has no such parameter and the same pin is one error.
+#[test]
+fn a_pin_design_on_a_diagnosis_pins_the_selected_term_s_parameter() {
+    let dir = scratch("design", "pin-diagnosis");
+    let run = |out: &Path, diagnosed: bool| {
+        let model = fixture("motor.toml");
+        let diagnosis = fixture("diagnosis.json");
+        let mut args = vec!["design", "--model", model.to_str().unwrap()];
+        if diagnosed {
+            args.extend(["--diagnosis", diagnosis.to_str().unwrap()]);
+        }
+        let out = out.to_str().unwrap().to_string();
+        args.extend([
+            "--pin",
+            "R,load_torque.T_0",
+            "--duration",
+            "0.05",
+            "--rate",
+            "400",
+            "--limits",
+            "U=±24,I=±300,omega=±3000",
+            "--segments",
+            "3",
+            "--starts",
+            "1",
+            "--out",
+        ]);
+        args.push(&out);
+        motorcal(&args)
+    };
+    let out = dir.join("diagnosed");
+    let o = run(&out, true);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("design.json")).unwrap()).unwrap();
+    let diagnosis: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(fixture("diagnosis.json")).unwrap()).unwrap();
+    for key in ["R", "load_torque.T_0"] {
+        assert_eq!(
+            json["pinned_at"]["values"][key], diagnosis["selected_params"][key],
+            "{key}"
+        );
+        assert!(json["expected_sd"][key].as_f64().unwrap() > 0.0, "{key}");
+    }
+    let bare = dir.join("bare");
+    let o = run(&bare, false);
+    one_error_line(&o, &["load_torque.T_0"]);
+    assert!(!bare.exists());
+}

@@ -13,13 +13,15 @@ use crate::design::{
     design_times,
 };
 use crate::io::{VoltageProfile, read_model_file, write_atomically, write_input_profile};
-use crate::motor::{MotorParam, VoltageInput};
+use crate::motor::VoltageInput;
 use crate::plot::{DesignChannel, DesignPlot, design_figure};
 use crate::study::Problem;
 
 use super::AppError;
 
+mod diagnosis;
 mod print;
+use diagnosis::{candidate_values, default_candidates, read_diagnosis, selected_model};
 use print::print_summary;
 
 // The options of `motorcal design`, as the command line and the tests give them.
@@ -28,7 +30,8 @@ pub struct DesignArgs {
     /// The user's model file (not the amended one).
     #[arg(long)]
     pub model: PathBuf,
-    /// A `diagnose --json` report: the candidates' fits and the noise σ.
+    /// A `diagnose --json` report: the candidates' fits and the noise σ (with --pin, the
+    /// selected model at its MAP, whose terms' parameters then can be pinned).
     #[arg(long)]
     pub diagnosis: Option<PathBuf>,
     /// Without --diagnosis: a recording to fit the --separate candidates to, or with --pin the
@@ -117,17 +120,28 @@ pub fn run(args: &DesignArgs) -> Result<(), AppError> {
         &args.pin
     {
         let targets: Vec<Target> = pins.iter().map(|p| Target::parse(p)).collect();
-        let (values, source) = if args.data.is_empty() {
-            (BTreeMap::new(), "the model's values")
-        } else {
-            let recorded = Problem::from_files(&args.data, &args.model)?;
-            let (values, sd) = design::pin_values_from(&recorded, &targets)?;
-            if args.noise_sd.is_none() {
-                noise_sd = sd;
+        // Where the design sits: the diagnosis's selected model at its MAP (its terms' own
+        // parameters then can be pinned), the model as given fitted to --data, or the file.
+        let (pinned_model, values, source) = match (&diagnosis, args.data.is_empty()) {
+            (Some(diagnosis), _) => {
+                let (terms, values) = selected_model(diagnosis)?;
+                (
+                    base.with_terms(&terms)?,
+                    values,
+                    "the diagnosis's selected model at its MAP",
+                )
             }
-            (values, "the model's MAP on the recordings")
+            (None, true) => (base.clone(), BTreeMap::new(), "the model's values"),
+            (None, false) => {
+                let recorded = Problem::from_files(&args.data, &args.model)?;
+                let (values, sd) = design::pin_values_from(&recorded, &targets)?;
+                if args.noise_sd.is_none() {
+                    noise_sd = sd;
+                }
+                (base.clone(), values, "the model's MAP on the recordings")
+            }
         };
-        let candidate = design::pin_candidate(&base, &values, &targets)?;
+        let candidate = design::pin_candidate(&pinned_model, &values, &targets)?;
         let experiment = Experiment {
             candidates: vec![candidate.clone()],
             times: times.clone(),
@@ -351,79 +365,6 @@ struct Figure {
     truth_name: String,
     truth: Vec<f64>,
     rival: Option<(String, Vec<f64>)>,
-}
-
-fn read_diagnosis(path: &Path) -> Result<Value, AppError> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| AppError::Usage(format!("--diagnosis {}: {e}", path.display())))?;
-    let value: Value = serde_json::from_str(&text).map_err(|e| {
-        AppError::Usage(format!(
-            "--diagnosis {}:{}: not a diagnose --json report: {e}",
-            path.display(),
-            e.line()
-        ))
-    })?;
-    if !value["ranking"].is_array() {
-        return Err(AppError::Usage(format!(
-            "--diagnosis {}: field 'ranking' missing: not a diagnose --json report",
-            path.display()
-        )));
-    }
-    Ok(value)
-}
-
-/// The selected term and its ties, and the pairs a drive's records cannot tell apart
-/// (`tied_pairs`: Coulomb friction and a load on records that never reverse).
-fn default_candidates(diagnosis: &Value) -> Result<Vec<String>, AppError> {
-    let mut names = vec![diagnosis["selected"].as_str().unwrap_or("none").to_string()];
-    let ties = diagnosis["ties"].as_array().into_iter().flatten();
-    let pairs = diagnosis["tied_pairs"]
-        .as_array()
-        .into_iter()
-        .flatten()
-        .flat_map(|pair| pair.as_array().into_iter().flatten());
-    for tie in ties.chain(pairs) {
-        if let Some(t) = tie.as_str()
-            && !names.iter().any(|n| n == t)
-        {
-            names.push(t.to_string());
-        }
-    }
-    if names.len() < 2 {
-        return Err(AppError::Usage(
-            "the diagnosis reports no tie: name the candidates with --separate".into(),
-        ));
-    }
-    Ok(names)
-}
-
-/// A candidate's fitted values from the diagnosis's ranking, keyed as the model's parameters.
-fn candidate_values(diagnosis: &Value, name: &str) -> Result<BTreeMap<String, f64>, AppError> {
-    let entry = diagnosis["ranking"]
-        .as_array()
-        .into_iter()
-        .flatten()
-        .find(|e| e["effect"].as_str() == Some(name))
-        .ok_or_else(|| {
-            AppError::Usage(format!(
-                "--separate {name}: the diagnosis's ranking has no fit of '{name}'"
-            ))
-        })?;
-    let base: Vec<&str> = MotorParam::ALL.iter().map(|p| p.key()).collect();
-    let mut values = BTreeMap::new();
-    for (key, v) in entry["params"].as_object().into_iter().flatten() {
-        let Some(v) = v.as_f64() else { continue };
-        if key == "I_sat" {
-            continue;
-        }
-        let key = if base.contains(&key.as_str()) || key.contains('.') {
-            key.clone()
-        } else {
-            format!("{name}.{key}")
-        };
-        values.insert(key, v);
-    }
-    Ok(values)
 }
 
 /// σ of each of `channels`: the command line's, else the diagnosis's fit's, else the paper's.
