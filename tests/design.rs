@@ -25,6 +25,33 @@ fn fixture(name: &str) -> PathBuf {
 }
 
 /// The fixture's drive: 24 V, 300 A, 3000 rad/s.
+/// `motorcal design ARGS` as a quick design: 0.05 s at 400 Hz within the paper's limits, three
+/// segments from one start, written to `out`.
+fn quick_design(args: &[&str], out: &Path) -> std::process::Output {
+    let mut all = vec!["design"];
+    all.extend_from_slice(args);
+    all.extend([
+        "--duration",
+        "0.05",
+        "--rate",
+        "400",
+        "--limits",
+        "U=±24,I=±300,omega=±3000",
+        "--segments",
+        "3",
+        "--starts",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    motorcal(&all)
+}
+
+/// The design.json a design wrote to `out`.
+fn design_json(out: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(out.join("design.json")).unwrap()).unwrap()
+}
+
 fn limits() -> Limits {
     "U=±24,I=±300,omega=±3000".parse().unwrap()
 }
@@ -336,32 +363,21 @@ fn design_fits_the_named_candidates_to_a_recording_when_no_diagnosis_is_given() 
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let out = dir.join("design");
-    let o = motorcal(&[
-        "design",
-        "--model",
-        sim.join("motor.toml").to_str().unwrap(),
-        "--data",
-        sim.join("recording.csv").to_str().unwrap(),
-        "--separate",
-        "load_torque,coulomb_friction",
-        "--duration",
-        "0.05",
-        "--rate",
-        "400",
-        "--limits",
-        "U=±24,I=±300,omega=±3000",
-        "--segments",
-        "3",
-        "--starts",
-        "1",
-        "--draws",
-        "2",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = quick_design(
+        &[
+            "--model",
+            sim.join("motor.toml").to_str().unwrap(),
+            "--data",
+            sim.join("recording.csv").to_str().unwrap(),
+            "--separate",
+            "load_torque,coulomb_friction",
+            "--draws",
+            "2",
+        ],
+        &out,
+    );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("design.json")).unwrap()).unwrap();
+    let json = design_json(&out);
     assert_eq!(
         json["candidates_at"]["source"],
         "their MAP on the recordings"
@@ -485,30 +501,19 @@ fn a_pin_design_on_a_recording_sits_at_the_recording_s_estimates() {
     let o = motorcal(&["simulate", "--seed", "5", "--out", sim.to_str().unwrap()]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let out = dir.join("design");
-    let o = motorcal(&[
-        "design",
-        "--model",
-        sim.join("motor.toml").to_str().unwrap(),
-        "--data",
-        sim.join("recording.csv").to_str().unwrap(),
-        "--pin",
-        "c_g/J",
-        "--duration",
-        "0.05",
-        "--rate",
-        "400",
-        "--limits",
-        "U=±24,I=±300,omega=±3000",
-        "--segments",
-        "3",
-        "--starts",
-        "1",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = quick_design(
+        &[
+            "--model",
+            sim.join("motor.toml").to_str().unwrap(),
+            "--data",
+            sim.join("recording.csv").to_str().unwrap(),
+            "--pin",
+            "c_g/J",
+        ],
+        &out,
+    );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("design.json")).unwrap()).unwrap();
+    let json = design_json(&out);
     assert_eq!(
         json["pinned_at"]["source"],
         "the model's MAP on the recordings"
@@ -532,39 +537,21 @@ fn a_pin_design_on_a_recording_sits_at_the_recording_s_estimates() {
 #[test]
 fn a_pin_design_on_a_diagnosis_pins_the_selected_term_s_parameter() {
     let dir = scratch("design", "pin-diagnosis");
+    let (model, diagnosis) = (fixture("motor.toml"), fixture("diagnosis.json"));
     let run = |out: &Path, diagnosed: bool| {
-        let model = fixture("motor.toml");
-        let diagnosis = fixture("diagnosis.json");
-        let mut args = vec!["design", "--model", model.to_str().unwrap()];
+        let mut args = vec!["--model", model.to_str().unwrap()];
         if diagnosed {
             args.extend(["--diagnosis", diagnosis.to_str().unwrap()]);
         }
-        let out = out.to_str().unwrap().to_string();
-        args.extend([
-            "--pin",
-            "R,load_torque.T_0",
-            "--duration",
-            "0.05",
-            "--rate",
-            "400",
-            "--limits",
-            "U=±24,I=±300,omega=±3000",
-            "--segments",
-            "3",
-            "--starts",
-            "1",
-            "--out",
-        ]);
-        args.push(&out);
-        motorcal(&args)
+        args.extend(["--pin", "R,load_torque.T_0"]);
+        quick_design(&args, out)
     };
     let out = dir.join("diagnosed");
     let o = run(&out, true);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("design.json")).unwrap()).unwrap();
+    let json = design_json(&out);
     let diagnosis: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(fixture("diagnosis.json")).unwrap()).unwrap();
+        serde_json::from_str(&std::fs::read_to_string(&diagnosis).unwrap()).unwrap();
     for key in ["R", "load_torque.T_0"] {
         assert_eq!(
             json["pinned_at"]["values"][key], diagnosis["selected_params"][key],
