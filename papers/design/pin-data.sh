@@ -16,6 +16,7 @@ done
 python3 - "$W" <<'PY'
 import json, sys
 w = sys.argv[1]
+sds, ratios = {}, {}
 for mode in ("file", "data"):
     r = json.load(open(f"{w}/{mode}/design.json"))
     at = r["pinned_at"]["values"]
@@ -24,5 +25,10 @@ for mode in ("file", "data"):
           f"σ {r['noise_sd']}; runtime {r['runtime_s']:.2f} s")
     rows = [("designed", r["expected_sd"])] + [(e["input"], e["expected_sd"]) for e in r["fixed_experiments"]]
     for name, sd in rows:
-        print(f"  {name:9s} expected sd R {sd['R']:.4g} Ω, c_g/J {sd['c_g/J']:.4g}")
+        print(f"  {name:9s} expected sd R {sd['R']:.4g} Ω, c_g/J {sd['c_g/J']:.4g} "
+              f"({sd['c_g/J'] / ratio:.3g} of the ratio)")
+    sds[mode], ratios[mode] = r["expected_sd"], ratio
+print(f"designed c_g/J sd at the recording's MAP over at the file's values: "
+      f"{sds['data']['c_g/J'] / sds['file']['c_g/J']:.3f}; "
+      f"the MAP's c_g/J over the truth's 0.01/5e-5: {ratios['data'] / 200:.4f}")
 PY

@@ -44,4 +44,8 @@ for name, sd in expected.items():
         cells += [f"{s:.4g} / {sd[k]:.4g}", f"{s / sd[k]:.3f}"]
     label = "designed" if name == "input" else name[len("fixed-"):]
     print(f"| {label} ({len(draws[keys[0]])} draws) | " + " | ".join(cells) + " |")
+for k in keys:
+    gains = ", ".join(f"{n[len('fixed-'):]} {sd[k] / expected['input'][k]:.3f}"
+                      for n, sd in expected.items() if n != "input")
+    print(f"{k}: each fixed input's expected sd over the designed one's: {gains}")
 PY
