@@ -21,7 +21,8 @@
 //! a fourth, `mains_pickup`, `bearing_defect`, `tacho_ripple` (the last two on slow records,
 //! `--volts 2`, where their ripples are sampled); a fifth, `eddy_brake`, `encoder_latency`,
 //! `crank_inertia`; a sixth, `current_sensor_resonance`, `sensor_heat_drift`, `load_ramp`,
-//! `rotor_rub`.
+//! `rotor_rub`; a seventh, `slew_limit`, `clutch_engagement`, `pwm_alias`, `speed_crosstalk`,
+//! `dc_link_resonance`.
 //!
 //! cargo run --release --example beyond_library_cases -- [--out DIR] [--per-effect 3]
 //!     [--seed-base 510000] [--min-nats 20] [--max-nats 300] [--effects a,b,…] [--volts 24]
@@ -160,6 +161,28 @@ enum Effect {
     /// −a·max(cos(θ + φ) − 0.7, 0)·sign(ω), a periodic pulse in the angle, not a sinusoid.
     /// `--effects rotor_rub`.
     RotorRub { a: f64, phase: f64 },
+    /// The output stage slewing at most r V/s: the applied voltage u_a follows the command by
+    /// du_a/dt = r·tanh((U − u_a)/(r·τ_a)), τ_a = 20 µs (its small-signal bandwidth). Its
+    /// size is 1/r. `--effects slew_limit`.
+    SlewLimit { inv_rate: f64 },
+    /// A fluid coupling engaging a second mass (share s of the inertia) at t_e: a torque
+    /// c·(ω − ω_x) from then on, c = s·J/10 ms, the mass spinning up from rest.
+    /// `--effects clutch_engagement`.
+    ClutchEngagement { share: f64, t_e: f64 },
+    /// The PWM's current ripple read by a sampler not synchronized with it: I read as
+    /// I + a·(1 − (U/30)²)·sin(2π·f·t + φ) (the ripple's duty dependence on a 30-V bus), f a
+    /// switching frequency near 19 kHz whose alias at the record's rate is f_a, 20–400 Hz.
+    /// `--effects pwm_alias`.
+    PwmAlias { a: f64, f_alias: f64, phase: f64 },
+    /// The current's field coupling into the speed sensor's lead: ω read as ω + κ·I.
+    /// `--effects speed_crosstalk`.
+    SpeedCrosstalk { kappa: f64 },
+    /// The drive's DC link: a bridge applying the duty U/V_bus of the bus's voltage v_c (V_bus
+    /// = 30 V at 24 V, scaled with `--volts`), the bus a capacitor C precharged to V_bus and fed
+    /// through L_f and R_f, which the motor's current drawn through the bridge (duty·I) sags and
+    /// rings; f = 1/(2π√(L_f·C)) 60–300 Hz, ζ = R_f/(2Z) 0.1–0.3, its size the impedance Z =
+    /// √(L_f/C). `--effects dc_link_resonance`.
+    DcLinkResonance { z: f64, f: f64, zeta: f64 },
 }
 
 impl Effect {
@@ -272,6 +295,22 @@ impl Effect {
                 a: 1e-3,
                 phase: rng.random_range(0.0..2.0 * PI),
             },
+            "slew_limit" => Effect::SlewLimit { inv_rate: 1e-5 },
+            "clutch_engagement" => Effect::ClutchEngagement {
+                share: 0.1,
+                t_e: rng.random_range(0.15..0.35),
+            },
+            "pwm_alias" => Effect::PwmAlias {
+                a: 1.0,
+                f_alias: rng.random_range(20.0..400.0),
+                phase: rng.random_range(0.0..2.0 * PI),
+            },
+            "speed_crosstalk" => Effect::SpeedCrosstalk { kappa: 0.05 },
+            "dc_link_resonance" => Effect::DcLinkResonance {
+                z: 0.01,
+                f: rng.random_range(60.0..300.0),
+                zeta: rng.random_range(0.1..0.3),
+            },
             other => panic!("unknown effect {other}; known: {:?}", Effect::NAMES),
         }
     }
@@ -311,6 +350,11 @@ impl Effect {
             Effect::CurrentSensorResonance { f_n, .. } => 1.0 / f_n,
             Effect::SensorHeatDrift { beta } => beta,
             Effect::LoadRamp { a } | Effect::RotorRub { a, .. } => a,
+            Effect::SlewLimit { inv_rate } => inv_rate,
+            Effect::ClutchEngagement { share, .. } => share,
+            Effect::PwmAlias { a, .. } => a,
+            Effect::SpeedCrosstalk { kappa } => kappa,
+            Effect::DcLinkResonance { z, .. } => z,
         }
     }
 
@@ -348,6 +392,11 @@ impl Effect {
             Effect::CurrentSensorResonance { f_n, .. } => *f_n = 1.0 / s,
             Effect::SensorHeatDrift { beta } => *beta = s,
             Effect::LoadRamp { a } | Effect::RotorRub { a, .. } => *a = s,
+            Effect::SlewLimit { inv_rate } => *inv_rate = s,
+            Effect::ClutchEngagement { share, .. } => *share = s,
+            Effect::PwmAlias { a, .. } => *a = s,
+            Effect::SpeedCrosstalk { kappa } => *kappa = s,
+            Effect::DcLinkResonance { z, .. } => *z = s,
         }
         e
     }
@@ -382,6 +431,12 @@ impl Effect {
             // A latency of at most 20 ms; an inertia that varies by at most half.
             Effect::EncoderLatency { .. } => 0.02,
             Effect::CrankInertia { .. } => 0.5,
+            // A slew of 24 V over at most 20 ms; a second mass at most as heavy as the rotor; a
+            // ripple of at most 50 A; a filter's impedance at most five times the winding's R.
+            Effect::SlewLimit { .. } => 0.02 / 24.0,
+            Effect::ClutchEngagement { .. } => 1.0,
+            Effect::PwmAlias { .. } => 50.0,
+            Effect::DcLinkResonance { .. } => 0.5,
             _ => 1.0,
         }
     }
@@ -530,6 +585,29 @@ fn rhs(
             torque -= a * ((x[2] + phase).cos() - 0.7).max(0.0) * w.tanh();
             dx[2] = w;
         }
+        Some(&Effect::SlewLimit { inv_rate }) => {
+            let (rate, tau_a) = (1.0 / inv_rate, 20e-6);
+            dx[2] = rate * ((u - x[2]) / (rate * tau_a)).tanh();
+            u = x[2];
+        }
+        Some(&Effect::ClutchEngagement { share, t_e }) => {
+            if t >= t_e {
+                let c = share * m.j / 10e-3;
+                let coupling = c * (w - x[2]);
+                torque -= coupling;
+                dx[2] = coupling / (share * m.j);
+            }
+        }
+        Some(&Effect::DcLinkResonance { z, f, zeta }) => {
+            // x[2] the filter's current, x[3] the bus's voltage less V_bus (so that both start
+            // at zero, the bus precharged).
+            let wr = 2.0 * PI * f;
+            let (l_f, c) = (z / wr, 1.0 / (wr * z));
+            let duty = u / (30.0 / 24.0 * input.level);
+            dx[2] = (-x[3] - 2.0 * zeta * z * x[2]) / l_f;
+            dx[3] = (x[2] - duty * i) / c;
+            u += duty * x[3];
+        }
         // The angle, which the tacho's ripple reads.
         Some(Effect::TachoRipple { .. }) => dx[2] = w,
         // These act on what is measured (`measured`, `simulate`), not on the motor.
@@ -540,7 +618,9 @@ fn rhs(
             | Effect::SpeedQuantization { .. }
             | Effect::SpeedOffset { .. }
             | Effect::MainsPickup { .. }
-            | Effect::EncoderLatency { .. },
+            | Effect::EncoderLatency { .. }
+            | Effect::PwmAlias { .. }
+            | Effect::SpeedCrosstalk { .. },
         )
         | None => {}
     }
@@ -569,6 +649,7 @@ fn measured(e: Option<&Effect>, x: &[f64; 4]) -> [f64; 2] {
         Some(&Effect::CurrentClip { i_sat }) => [x[0].clamp(-i_sat, i_sat), x[1]],
         Some(&Effect::SpeedQuantization { q }) => [x[0], q * (x[1] / q).round()],
         Some(&Effect::SpeedOffset { b }) => [x[0], x[1] + b],
+        Some(&Effect::SpeedCrosstalk { kappa }) => [x[0], x[1] + kappa * x[0]],
         Some(&Effect::TachoRipple { eps, k, phase }) => {
             [x[0], x[1] * (1.0 + eps * (k as f64 * x[2] + phase).sin())]
         }
@@ -616,6 +697,13 @@ fn simulate(m: &Motor, e: Option<&Effect>, input: &Input, times: &[f64]) -> Vec<
         }
         if let Some(&Effect::MainsPickup { a, f, phase }) = e {
             y[0] += a * (2.0 * PI * f * t + phase).sin();
+        }
+        if let Some(&Effect::PwmAlias { a, f_alias, phase }) = e {
+            // The switching frequency: 19 times the record's rate above its alias.
+            let rate = (times.len() - 1) as f64 / (times[times.len() - 1] - times[0]);
+            let f = 19.0 * rate + f_alias;
+            let duty = input.at(t, times) / 30.0;
+            y[0] += a * (1.0 - duty * duty) * (2.0 * PI * f * t + phase).sin();
         }
         out.push(y);
     }
@@ -681,7 +769,7 @@ fn nominal_miss(truth: &[[f64; 2]], input: &Input, times: &[f64]) -> (f64, f64) 
 }
 
 /// The fingerprint a tool should find, as the JSON contract of issue 19 names it.
-fn expected(e: &Effect) -> String {
+fn expected(e: &Effect, input_level: f64) -> String {
     match *e {
         Effect::Stribeck { .. } => r#"{"kind": "state", "balance": "torque", "functions": ["exp(-(omega/omega_s)^2)*sign(omega)", "sign(omega)"]}"#.into(),
         Effect::PeriodicLoad { f, .. } => format!(r#"{{"kind": "oscillation", "frequency_hz": {f}, "ringing": false}}"#),
@@ -736,6 +824,18 @@ fn expected(e: &Effect) -> String {
         Effect::LoadRamp { .. } => r#"{"kind": "drift", "variable": "time", "balance": "torque"}"#.into(),
         // A pulse in the angle: its harmonics, the first of which a 24-V record samples.
         Effect::RotorRub { .. } => r#"{"kind": "state", "balance": "torque", "functions": ["sin(k*theta)", "cos(k*theta)"], "k": 1}"#.into(),
+        // A ramp of ΔU/r in place of the first step lags the response by about half of it, and
+        // the stage's small-signal lag τ_a by τ_a.
+        Effect::SlewLimit { inv_rate } => format!(r#"{{"kind": "delay", "seconds": {}}}"#, 0.5 * input_level * inv_rate + 20e-6),
+        // A mass engaging through a coupling is a torque of the history (the second mass's
+        // speed), no function of the state: something is left that no dictionary names.
+        Effect::ClutchEngagement { .. } => r#"{"kind": "unknown"}"#.into(),
+        Effect::PwmAlias { f_alias, .. } => format!(r#"{{"kind": "oscillation", "frequency_hz": {f_alias}, "channel": "I", "ringing": false}}"#),
+        Effect::SpeedCrosstalk { .. } => r#"{"kind": "state", "balance": "measurement:omega", "functions": ["I"]}"#.into(),
+        Effect::DcLinkResonance { z, f, zeta } => {
+            let (fr, zr) = dc_link_ringing(z, f, zeta, 24.0 / 30.0);
+            format!(r#"{{"kind": "oscillation", "frequency_hz": {fr}, "damping_ratio": {zr}, "channel": "I", "ringing": true}}"#)
+        }
         // The torque lost, ε·sin(kθ + φ)·c_g·I, as the law's two coefficients (c_g the nominal's,
         // which the truth keeps).
         Effect::LoadRipple { eps, k, phase } => format!(
@@ -744,6 +844,30 @@ fn expected(e: &Effect) -> String {
             -eps * NOMINAL.c_g * phase.sin()
         ),
     }
+}
+
+/// The ringing of the DC link with the nominal motor on it at the duty of the record's first
+/// level: the damped frequency (Hz) and damping ratio of the linearized circuit's most
+/// oscillatory pair of eigenvalues (states I, ω, the filter's current, the bus's voltage).
+/// The winding loads the bus through the bridge, so this is not the bare LC's resonance.
+fn dc_link_ringing(z: f64, f: f64, zeta: f64, duty: f64) -> (f64, f64) {
+    let m = NOMINAL;
+    let wr = 2.0 * PI * f;
+    let (l_f, c) = (z / wr, 1.0 / (wr * z));
+    #[rustfmt::skip]
+    let a = nalgebra::Matrix4::new(
+        -m.r / m.l, -m.c_m / m.l, 0.0, duty / m.l,
+        m.c_g / m.j, -m.d / m.j, 0.0, 0.0,
+        0.0, 0.0, -2.0 * zeta * z / l_f, -1.0 / l_f,
+        -duty / c, 0.0, 1.0 / c, 0.0,
+    );
+    let pair = a
+        .complex_eigenvalues()
+        .iter()
+        .copied()
+        .max_by(|p, q| p.im.abs().total_cmp(&q.im.abs()))
+        .unwrap();
+    (pair.im.abs() / (2.0 * PI), -pair.re / pair.norm())
 }
 
 fn arg<T: std::str::FromStr>(args: &[String], name: &str, default: T) -> T {
@@ -887,7 +1011,7 @@ fn main() {
                         | Effect::SensorLag { .. }
                         | Effect::CompliantCoupling { .. }
                 ),
-                expected(&effect),
+                expected(&effect, input.level),
                 if type_b { "B" } else { "A" },
                 peak[0],
                 peak[1]
