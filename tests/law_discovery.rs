@@ -515,6 +515,31 @@ fn a_speed_sensor_s_offset_is_discovered_as_a_constant_in_what_is_read() {
     assert!(!law.equation.contains('·'), "{}", law.equation);
 }
 
+/// A speed sensor picking up the current's field (ω read as ω + κ·I; speed_crosstalk-780019, a
+/// held input, of `--effects slew_limit,clutch_engagement,pwm_alias,speed_crosstalk,
+/// dc_link_resonance --per-effect 4 --seed-base 780000`): a compliant coupling damped far past
+/// critical (ζ ≈ 6) reads the same, its motor side running ahead of the load, and was selected
+/// for it. A coupling that rings not is tried against the reading of I in ω in its place, and
+/// the law is discovered, its 95% interval holding κ.
+#[test]
+fn a_speed_sensor_reading_the_current_is_discovered_in_place_of_a_coupling_that_rings_not() {
+    let (problem, answer) = fixture("speed_crosstalk-780019");
+    let kappa = truth_value(&answer, "kappa");
+    let d = diagnose(&problem);
+    assert_eq!(d.selected_set, ["law"], "no coupling beside it");
+    let law = discovered_in(&d, "measurement:omega", &["I"]);
+    assert!(
+        holds(&law.functions[0], kappa),
+        "{} vs {kappa}",
+        law.equation
+    );
+    assert!(
+        d.notes.iter().any(|n| n.contains("rings not")),
+        "{:?}",
+        d.notes
+    );
+}
+
 /// Where a library term holds the effect, the law the model as given asks for is that term
 /// written in the dictionary (a back-EMF constant is c·ω in the voltage balance): fitted in
 /// its place it ties, and the library's name stands.

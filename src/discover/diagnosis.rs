@@ -20,6 +20,7 @@ use super::coincide::InputCoincidence;
 use super::discovered::{Discovered, discovered};
 use super::fits::{self, Convergence, FitSummary, Mismatch, SampledFit};
 use super::named::{Naming, fit_named_terms};
+use super::overdamped::reading_in_place;
 use super::prune::prune_law;
 use super::screen::collinear_pairs;
 use super::selection::Selection;
@@ -239,7 +240,15 @@ pub fn assemble(
         naming.push((as_given.fingerprints().collect(), vec![&none]));
     }
     // One call, so that a law both name is fitted once and all the fits share the cores.
-    let best = fit_named_terms(problem, naming, &selected_fit, allowed)?;
+    let mut best = fit_named_terms(problem, naming, &selected_fit, allowed)?;
+    // An overdamped coupling's look-alike, the speed's reading of the current, in its place.
+    let mut not_ranked = not_ranked;
+    if let Some((fit, note)) = reading_in_place(problem, &selected_fit, allowed) {
+        not_ranked.push(note);
+        if let Some(fit) = fit.filter(|f| best.as_ref().is_none_or(|b| f.score > b.score)) {
+            best = Some(fit);
+        }
+    }
     if let Some(fit) = best {
         let before = selected_fit.score;
         found = discovered(&fit, fit.score - before);

@@ -56,6 +56,7 @@ mod diagnosis;
 mod discovered;
 mod fits;
 mod named;
+mod overdamped;
 mod prune;
 mod screen;
 mod selection;
