@@ -149,27 +149,17 @@ fn the_same_seed_gives_the_same_design_whatever_the_thread_count() {
 fn a_small_design_runs_end_to_end() {
     let dir = scratch("design", "e2e");
     let out = dir.join("design");
-    let o = motorcal(&[
-        "design",
-        "--model",
-        fixture("motor.toml").to_str().unwrap(),
-        "--diagnosis",
-        fixture("diagnosis.json").to_str().unwrap(),
-        "--duration",
-        "0.05",
-        "--rate",
-        "400",
-        "--limits",
-        "U=±24,I=±300,omega=±3000",
-        "--segments",
-        "3",
-        "--starts",
-        "1",
-        "--draws",
-        "2",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = quick_design(
+        &[
+            "--model",
+            fixture("motor.toml").to_str().unwrap(),
+            "--diagnosis",
+            fixture("diagnosis.json").to_str().unwrap(),
+            "--draws",
+            "2",
+        ],
+        &out,
+    );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let input = read_voltage_profile(&out.join("input.csv")).unwrap();
     assert_eq!(input.times.len(), 20);

@@ -410,7 +410,6 @@ fn fit_named_at(
     named: &NamedTerm,
     warm: Option<&Candidate>,
 ) -> Result<Candidate, Error> {
-    let search_penalty = named.search_penalty;
     let name = named.term.name().to_string();
     let mut added = with.added.clone();
     let term = match (&named.term, added_law(with)) {
@@ -423,18 +422,8 @@ fn fit_named_at(
             named.term.clone()
         }
     };
-    let mut starts = Starts {
-        terms: vec![term],
-        ..Starts::default()
-    };
-    for &(key, value) in &named.start {
-        starts
-            .values
-            .insert(ParamId::of_term(&name, key).to_string(), value);
-    }
-    if search_penalty > 0.0 {
-        starts.search_penalty.insert(name.clone(), search_penalty);
-    }
+    let mut starts = starts_of(named);
+    starts.terms = vec![term];
     // A fit of the same model at a nearby shape gives two starts: every parameter at its
     // estimates, or `with`'s beside its law's coefficients. Each alone stalled on
     // bearing_defect-690003, thousands of nats below the other on some shapes; the search
@@ -451,6 +440,27 @@ fn fit_named_at(
         .map(|(k, v)| (k.clone(), *v))
         .collect();
     fit_candidate_warmed(problem, &added, &[warm, &with_law], &starts)
+}
+
+/// What a fit of `named` starts from: its settings, its parameters' values and what its score
+/// pays for the grid its start was the best of.
+pub(super) fn starts_of(named: &NamedTerm) -> Starts {
+    let name = named.term.name();
+    let mut starts = Starts {
+        terms: vec![named.term.clone()],
+        ..Starts::default()
+    };
+    for &(key, value) in &named.start {
+        starts
+            .values
+            .insert(ParamId::of_term(name, key).to_string(), value);
+    }
+    if named.search_penalty > 0.0 {
+        starts
+            .search_penalty
+            .insert(name.to_string(), named.search_penalty);
+    }
+    starts
 }
 
 /// The law `fit`'s model holds, if one.

@@ -14,25 +14,44 @@
 //! it is offered only as the overdamped coupling's alternative, fitted through the ODE in the
 //! coupling's place, and the fits decide by the ranking's threshold.
 
-use crate::error::Error;
-use crate::motor::Term;
-use crate::motor::dictionary::{self, BALANCES, FUNCTIONS, N_FUNCTIONS};
 use crate::parameter::ParamId;
 use crate::study::Problem;
 
-use super::candidate::{Candidate, Starts, fit_candidate_started};
+use super::candidate::{Candidate, fit_candidate_started};
+use super::named::{named_term, starts_of};
 use super::settings::EVIDENCE_THRESHOLD;
+use super::unexplained::{Fingerprint, LawFunction};
 
 const COUPLING: &str = "compliant_coupling";
 
 /// The damping ratio above which a coupling's modes are real: it does not ring.
 const CRITICAL_DAMPING: f64 = 1.0;
 
+/// The speed's reading of the current, as the state fingerprint a law is named from, its
+/// coefficient started at zero.
+fn crosstalk() -> Fingerprint {
+    Fingerprint::State {
+        balance: "measurement:omega".into(),
+        functions: vec![LawFunction {
+            name: "I".into(),
+            coefficient: 0.0,
+            sd: 0.0,
+        }],
+        omega_s: None,
+        harmonic: None,
+        current_limit: None,
+        step: None,
+        harmonic_price: 0.0,
+        harmonic_width: 0.0,
+        score: 0.0,
+    }
+}
+
 /// Where `selected` holds a coupling damped past critical: the law reading the current in the
 /// speed fitted in the coupling's place (the other selected terms kept), and a note of what was
 /// tried and what it scored; the fit only where it beats `selected` by more than the threshold.
-/// None where there is no such coupling, the model holds a law already, or the user's
-/// candidates (`allowed`) leave no law to add.
+/// None where there is no such coupling, the model or its base takes no such law
+/// (`named::named_term`), or the user's candidates (`allowed`) leave no law to add.
 pub(super) fn reading_in_place(
     problem: &Problem,
     selected: &Candidate,
@@ -40,7 +59,6 @@ pub(super) fn reading_in_place(
 ) -> Option<(Option<Candidate>, String)> {
     if !selected.added.iter().any(|a| a == COUPLING)
         || allowed.is_some_and(|a| !a.iter().any(|c| c == "law"))
-        || problem.model.terms.iter().any(|t| t.term.name() == "law")
     {
         return None;
     }
@@ -50,47 +68,29 @@ pub(super) fn reading_in_place(
     if zeta <= CRITICAL_DAMPING {
         return None;
     }
-    let Some(Term::Law(law)) = Term::named("law") else {
-        return None;
-    };
-    let balance = BALANCES.iter().position(|b| *b == "measurement:omega")?;
-    let current = FUNCTIONS.iter().position(|f| *f == "I")?;
-    let k = balance * N_FUNCTIONS + current;
-    let term = Term::Law(law.with_active(vec![k]));
-    if !problem.model.base.accepts(&term) {
-        return None;
-    }
+    let named = named_term(problem, &crosstalk())?;
     let mut added: Vec<String> = (selected.added.iter())
         .filter(|a| *a != COUPLING)
         .cloned()
         .collect();
-    added.push("law".into());
-    let key = ParamId::of_term("law", dictionary::key(k)).to_string();
-    let mut starts = Starts {
-        terms: vec![term],
-        ..Starts::default()
-    };
-    starts.values.insert(key.clone(), 0.0);
+    added.push(named.term.name().into());
+    let head = format!("{COUPLING}'s damping ratio is {zeta:.3}, over 1: it rings not");
     // A fit that fails is no candidate, as a named term's is not (`named::fit_named_terms`).
-    let fit: Result<Candidate, Error> =
-        fit_candidate_started(problem, &added, Some(selected), &starts);
-    let Ok(fit) = fit else {
+    let Ok(fit) = fit_candidate_started(problem, &added, Some(selected), &starts_of(&named)) else {
         return Some((
             None,
             format!(
-                "{COUPLING}'s damping ratio is {zeta:.3}, over 1: it rings not; a reading of \
-                 the current in the speed's (measured omega += κ·I) in its place could not be \
-                 fitted"
+                "{head}; a reading of the current in the speed's in its place could not be fitted"
             ),
         ));
     };
+    let key = ParamId::of_term(named.term.name(), named.start[0].0).to_string();
     let gain = fit.score - selected.score;
     let taken = gain > EVIDENCE_THRESHOLD;
     let note = format!(
-        "{COUPLING}'s damping ratio is {zeta:.3}, over 1: it rings not, and what it holds is \
-         the motor's side running ahead of the load; a reading of the current in the speed's \
-         (crosstalk: measured omega += {:.4e}·I) fitted in its place scores {gain:+.2} nats \
-         against it, {}",
+        "{head}, and what it holds is the motor's side running ahead of the load; a reading of \
+         the current in the speed's (crosstalk: measured omega += {:.4e}·I) fitted in its place \
+         scores {gain:+.2} nats against it, {}",
         fit.theta.get(&key).copied().unwrap_or(f64::NAN),
         if taken {
             "and is taken"
