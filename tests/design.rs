@@ -554,3 +554,30 @@ fn a_pin_design_on_a_diagnosis_pins_the_selected_term_s_parameter() {
     one_error_line(&o, &["load_torque.T_0"]);
     assert!(!bare.exists());
 }
+
+#[test]
+fn a_pin_design_on_a_diagnosis_that_selected_a_law_is_refused_with_where_the_law_lives() {
+    // A law's functions are written into the amended model.toml, not into the report's term
+    // names, so a design from the report alone could not rebuild the selected model.
+    let dir = scratch("design", "pin-diagnosis-law");
+    let mut diagnosis: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(fixture("diagnosis.json")).unwrap()).unwrap();
+    diagnosis["selected_set"] = serde_json::json!(["law"]);
+    let report = dir.join("law-diagnosis.json");
+    std::fs::write(&report, diagnosis.to_string()).unwrap();
+    let out = dir.join("out");
+    let model = fixture("motor.toml");
+    let o = quick_design(
+        &[
+            "--model",
+            model.to_str().unwrap(),
+            "--diagnosis",
+            report.to_str().unwrap(),
+            "--pin",
+            "R",
+        ],
+        &out,
+    );
+    one_error_line(&o, &["discovered law", "amended model.toml", "--model"]);
+    assert!(!out.exists());
+}
