@@ -5,6 +5,10 @@
 //! A law adds Σ c·f(state, input) to one of the two balances; a coefficient is keyed
 //! `balance:function` (`torque:sign(omega)*|I|`).
 
+use std::cell::OnceCell;
+use std::f64::consts::TAU;
+
+use super::terms::{exp_below_one, tanh};
 use super::{Magnitudes, Scalar};
 
 /// The functions, in the order of the law's parameters (within each balance).
@@ -231,57 +235,106 @@ pub struct Point<D> {
 
 /// Function `f` of the dictionary at `x`.
 pub fn value<D: Scalar>(f: usize, x: &Point<D>, s: &Shapes) -> D {
-    let sign = || super::terms::tanh(x.speed / s.omega_smooth);
-    let phase = 2.0 * std::f64::consts::PI * s.frequency * x.t;
-    match f {
-        0 => x.speed,
-        1 => x.speed * x.speed.abs(),
-        2 => x.speed * x.speed * x.speed,
-        3 => sign(),
-        4 => {
-            let r = x.speed / s.omega_s;
-            (-(r * r)).exp() * sign()
+    At::new(x, s).value(f)
+}
+
+/// The dictionary at one point, the factors its functions share (sign(ω), the sine and cosine
+/// of the angle's harmonic and of the time's phase) computed once for all the functions a law
+/// asks of it. num-dual's `sin` and `cos` each take both of libm's, so a law in sin(kθ) and
+/// cos(kθ) paid four calls for the two that `sin_cos` gives, and the same numbers.
+pub struct At<'a, D> {
+    x: &'a Point<D>,
+    s: &'a Shapes,
+    sign: OnceCell<D>,
+    angle: OnceCell<(D, D)>,
+    phase: OnceCell<(f64, f64)>,
+}
+
+impl<'a, D: Scalar> At<'a, D> {
+    pub fn new(x: &'a Point<D>, s: &'a Shapes) -> Self {
+        let (sign, angle, phase) = (OnceCell::new(), OnceCell::new(), OnceCell::new());
+        Self {
+            x,
+            s,
+            sign,
+            angle,
+            phase,
         }
-        5 => x.current,
-        6 => x.current.abs(),
-        7 => x.current * x.current.abs(),
-        8 => sign() * x.current.abs(),
-        9 => x.voltage,
-        CHARGE => x.charge,
-        HEAT => x.heat,
-        TIME => D::from(x.t),
-        SIN_THETA => (x.theta * s.harmonic).sin(),
-        COS_THETA => (x.theta * s.harmonic).cos(),
-        15 => D::from(phase.sin()),
-        16 => D::from(phase.cos()),
-        U_CHARGE => x.voltage * x.charge,
-        OMEGA_HEAT => x.speed * x.heat,
-        I_HEAT => x.current * x.heat,
-        // The hinge smoothed over 3% of the limit (a softplus), as sign(ω) is over ω_smooth:
-        // with a kink, or a softplus over 1% or 2%, the sensitivities' right-hand side jumps
-        // where the state's only bends, and as the integrator controls the state's error and
-        // not theirs they missed finite differences by 0.33%, 0.26%, 0.13% (tests/law.rs asks
-        // 0.1%). The price: a stiff limit's gain is fitted low (the softened hinge acts below
-        // the limit too); its level is not.
-        CURRENT_LIMIT => {
-            let width = 0.03 * s.current_limit;
-            let z = (x.current.abs() - s.current_limit) / width;
-            let softplus = if z.re() > 0.0 {
-                z + ((-z).exp() + 1.0).ln()
-            } else {
-                (z.exp() + 1.0).ln()
-            };
-            softplus * width * x.current.re().signum()
+    }
+
+    fn sign(&self) -> D {
+        *self
+            .sign
+            .get_or_init(|| tanh(self.x.speed / self.s.omega_smooth))
+    }
+
+    /// sin(kθ), cos(kθ).
+    fn angle(&self) -> (D, D) {
+        *self
+            .angle
+            .get_or_init(|| (self.x.theta * self.s.harmonic).sin_cos())
+    }
+
+    /// sin(2πft), cos(2πft).
+    fn phase(&self) -> (f64, f64) {
+        *self
+            .phase
+            .get_or_init(|| (TAU * self.s.frequency * self.x.t).sin_cos())
+    }
+
+    /// Function `f` of the dictionary here.
+    pub fn value(&self, f: usize) -> D {
+        let (x, s) = (self.x, self.s);
+        match f {
+            0 => x.speed,
+            1 => x.speed * x.speed.abs(),
+            2 => x.speed * x.speed * x.speed,
+            3 => self.sign(),
+            4 => {
+                let r = x.speed / s.omega_s;
+                exp_below_one(-(r * r)) * self.sign()
+            }
+            5 => x.current,
+            6 => x.current.abs(),
+            7 => x.current * x.current.abs(),
+            8 => self.sign() * x.current.abs(),
+            9 => x.voltage,
+            CHARGE => x.charge,
+            HEAT => x.heat,
+            TIME => D::from(x.t),
+            SIN_THETA => self.angle().0,
+            COS_THETA => self.angle().1,
+            15 => D::from(self.phase().0),
+            16 => D::from(self.phase().1),
+            U_CHARGE => x.voltage * x.charge,
+            OMEGA_HEAT => x.speed * x.heat,
+            I_HEAT => x.current * x.heat,
+            // The hinge smoothed over 3% of the limit (a softplus), as sign(ω) is over
+            // ω_smooth: with a kink, or a softplus over 1% or 2%, the sensitivities' right-hand
+            // side jumps where the state's only bends, and as the integrator controls the
+            // state's error and not theirs they missed finite differences by 0.33%, 0.26%,
+            // 0.13% (tests/law.rs asks 0.1%). The price: a stiff limit's gain is fitted low
+            // (the softened hinge acts below the limit too); its level is not.
+            CURRENT_LIMIT => {
+                let width = 0.03 * s.current_limit;
+                let z = (x.current.abs() - s.current_limit) / width;
+                let softplus = if z.re() > 0.0 {
+                    z + ((-z).exp() + 1.0).ln()
+                } else {
+                    (z.exp() + 1.0).ln()
+                };
+                softplus * width * x.current.re().signum()
+            }
+            THETA => x.theta,
+            CONSTANT => D::from(1.0),
+            I_SIN_THETA => x.current * self.angle().0,
+            I_COS_THETA => x.current * self.angle().1,
+            U_SIN_FT => x.voltage * self.phase().0,
+            U_COS_FT => x.voltage * self.phase().1,
+            OMEGA_SIN_THETA => x.speed * self.angle().0,
+            OMEGA_COS_THETA => x.speed * self.angle().1,
+            _ => unreachable!("the dictionary has {N_FUNCTIONS} functions"),
         }
-        THETA => x.theta,
-        CONSTANT => D::from(1.0),
-        I_SIN_THETA => x.current * value(SIN_THETA, x, s),
-        I_COS_THETA => x.current * value(COS_THETA, x, s),
-        U_SIN_FT => x.voltage * phase.sin(),
-        U_COS_FT => x.voltage * phase.cos(),
-        OMEGA_SIN_THETA => x.speed * value(SIN_THETA, x, s),
-        OMEGA_COS_THETA => x.speed * value(COS_THETA, x, s),
-        _ => unreachable!("the dictionary has {N_FUNCTIONS} functions"),
     }
 }
 

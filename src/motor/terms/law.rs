@@ -242,12 +242,13 @@ impl PhysicsTerm for Law {
             heat: site.states[1],
             theta: site.states[2],
         };
+        let here = dictionary::At::new(&x, &self.shapes);
         for &k in self
             .active
             .iter()
             .filter(|&&k| k < ODE_BALANCES * N_FUNCTIONS)
         {
-            let term = site.params[k] * dictionary::value(k % N_FUNCTIONS, &x, &self.shapes);
+            let term = site.params[k] * here.value(k % N_FUNCTIONS);
             if k < N_FUNCTIONS {
                 b.torque += term;
             } else {
@@ -272,8 +273,9 @@ impl PhysicsTerm for Law {
             heat: states[1],
             theta: states[2],
         };
+        let here = dictionary::At::new(&x, &self.shapes);
         for &k in self.active.iter().filter(|&&k| k >= first) {
-            let read = params[k] * dictionary::value(k % N_FUNCTIONS, &x, &self.shapes);
+            let read = params[k] * here.value(k % N_FUNCTIONS);
             channels[k / N_FUNCTIONS - ODE_BALANCES] += read;
         }
     }
