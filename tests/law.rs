@@ -3,7 +3,8 @@
 //! law of what is read adds to the reading alone; a law holding one library term's shape is
 //! that term (viscous friction, Coulomb friction); a model file with a law reads back as
 //! written, with its active coefficients alone; an unknown function is refused with the file
-//! and the key named.
+//! and the key named; the dictionary at one point shares its common factors without changing a
+//! bit of any function.
 
 use motorcal::forward::ForwardModel;
 use motorcal::io::read_model_file;
@@ -279,5 +280,74 @@ fn an_unknown_function_is_refused_naming_the_file_and_the_key() {
                 && e.contains(why),
             "{key}: {e}"
         );
+    }
+}
+
+/// The dictionary at one point computes the factors its functions share once (sign(ω), the
+/// sine and cosine of kθ and of 2πft): whatever order a law asks them in, each function is
+/// its own formula, value and derivative, with the numbers num-dual's own sin, cos and exp
+/// give.
+#[test]
+fn the_dictionary_at_one_point_gives_each_shared_factor_its_own_formula_in_any_order() {
+    use motorcal::motor::dictionary::{At, Point, Shapes};
+    use num_dual::{Dual64, DualNum};
+    let shapes = Shapes {
+        omega_smooth: 0.5,
+        omega_s: 30.0,
+        frequency: 74.8,
+        harmonic: 6.0,
+        current_limit: 200.0,
+    };
+    // A direction through every state at once, so a factor taken for another one shows.
+    let x = Point {
+        t: 0.0137,
+        current: Dual64::new(-41.0, 0.7),
+        speed: Dual64::new(-12.5, -2.0),
+        voltage: Dual64::new(17.0, 0.3),
+        charge: Dual64::new(0.4, 0.1),
+        heat: Dual64::new(2.2, 0.2),
+        theta: Dual64::new(3.1, 1.3),
+    };
+    let angle = x.theta * shapes.harmonic;
+    let phase = std::f64::consts::TAU * shapes.frequency * x.t;
+    let sign = {
+        let e = (x.speed / shapes.omega_smooth * 2.0).exp();
+        (e - 1.0) / (e + 1.0)
+    };
+    let r = x.speed / shapes.omega_s;
+    let expected = |name: &str| -> Dual64 {
+        match name {
+            "sign(omega)" => sign,
+            // I < 0 here: |I| is −I.
+            "sign(omega)*|I|" => sign * -x.current,
+            "exp(-(omega/omega_s)^2)*sign(omega)" => (-(r * r)).exp() * sign,
+            "sin(k*theta)" => angle.sin(),
+            "cos(k*theta)" => angle.cos(),
+            "I*sin(k*theta)" => x.current * angle.sin(),
+            "I*cos(k*theta)" => x.current * angle.cos(),
+            "omega*sin(k*theta)" => x.speed * angle.sin(),
+            "omega*cos(k*theta)" => x.speed * angle.cos(),
+            "sin(2*pi*f*t)" => Dual64::from(phase.sin()),
+            "cos(2*pi*f*t)" => Dual64::from(phase.cos()),
+            "U*sin(2*pi*f*t)" => x.voltage * phase.sin(),
+            "U*cos(2*pi*f*t)" => x.voltage * phase.cos(),
+            other => panic!("{other} is not a shared factor's function"),
+        }
+    };
+    let shared: Vec<usize> = (0..N_FUNCTIONS)
+        .filter(|&f| {
+            let name = FUNCTIONS[f];
+            name.contains("sign(omega)") || name.contains("sin") || name.contains("cos")
+        })
+        .collect();
+    assert_eq!(shared.len(), 13);
+    for order in [shared.clone(), shared.iter().rev().copied().collect()] {
+        let here = At::new(&x, &shapes);
+        for &f in &order {
+            let (got, want) = (here.value(f), expected(FUNCTIONS[f]));
+            // Value and derivative alike, to the last bit.
+            assert_eq!(got.re.to_bits(), want.re.to_bits(), "{}", FUNCTIONS[f]);
+            assert_eq!(got.eps.to_bits(), want.eps.to_bits(), "d {}", FUNCTIONS[f]);
+        }
     }
 }
