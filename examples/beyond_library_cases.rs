@@ -22,7 +22,8 @@
 //! `--volts 2`, where their ripples are sampled); a fifth, `eddy_brake`, `encoder_latency`,
 //! `crank_inertia`; a sixth, `current_sensor_resonance`, `sensor_heat_drift`, `load_ramp`,
 //! `rotor_rub`; a seventh, `slew_limit`, `clutch_engagement`, `pwm_alias`, `speed_crosstalk`,
-//! `dc_link_resonance`.
+//! `dc_link_resonance`; an eighth, `pump_threshold`, `hydraulic_load`, `encoder_glitch`,
+//! `commutator_ripple` (the last on slow records, `--volts 2`).
 //!
 //! cargo run --release --example beyond_library_cases -- [--out DIR] [--per-effect 3]
 //!     [--seed-base 510000] [--min-nats 20] [--max-nats 300] [--effects a,b,…] [--volts 24]
@@ -183,6 +184,30 @@ enum Effect {
     /// rings; f = 1/(2π√(L_f·C)) 60–300 Hz, ζ = R_f/(2Z) 0.1–0.3, its size the impedance Z =
     /// √(L_f/C). `--effects dc_link_resonance`.
     DcLinkResonance { z: f64, f: f64, zeta: f64 },
+    /// A pump behind a relief valve as the load: no torque until the speed passes ω_0 (a
+    /// share of the record's no-load speed, 0.3–0.7), then −a·(ω − ω_0)², and none backwards
+    /// (a check valve). `--effects pump_threshold`.
+    PumpThreshold { a: f64, share: f64 },
+    /// A hydraulic load whose pressure follows the speed with a lag: dp/dt = (ω − p)/τ_p,
+    /// τ_p 10–50 ms, a torque −a·p (a torque of a hidden state, viscous once settled).
+    /// `--effects hydraulic_load`.
+    HydraulicLoad { a: f64, tau_p: f64 },
+    /// An encoder's miscounts: on about 1% of the samples (chosen by `salt`) ω is read ±a
+    /// off, the sign by the same hash. `--effects encoder_glitch`.
+    EncoderGlitch { a: f64, salt: u64 },
+    /// A commutator's ripple of the flux, k times per revolution: both constants scaled by
+    /// 1 + ε·sin(kθ + φ), in the back-EMF and the torque alike (on slow records, `--volts 2`).
+    /// `--effects commutator_ripple`.
+    CommutatorRipple { eps: f64, k: u32, phase: f64 },
+}
+
+/// Whether sample `k` is one the encoder miscounts, and the sign: splitmix64 of salt and k.
+fn glitch(salt: u64, k: usize) -> Option<f64> {
+    let mut z = salt ^ (k as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^= z >> 31;
+    (z % 100 == 0).then(|| if (z >> 40) & 1 == 1 { 1.0 } else { -1.0 })
 }
 
 impl Effect {
@@ -311,6 +336,23 @@ impl Effect {
                 f: rng.random_range(60.0..300.0),
                 zeta: rng.random_range(0.1..0.3),
             },
+            "pump_threshold" => Effect::PumpThreshold {
+                a: 1e-8,
+                share: rng.random_range(0.3..0.7),
+            },
+            "hydraulic_load" => Effect::HydraulicLoad {
+                a: 1e-6,
+                tau_p: rng.random_range(0.01..0.05),
+            },
+            "encoder_glitch" => Effect::EncoderGlitch {
+                a: 10.0,
+                salt: rng.random(),
+            },
+            "commutator_ripple" => Effect::CommutatorRipple {
+                eps: 0.01,
+                k: rng.random_range(2..=5),
+                phase: rng.random_range(0.0..2.0 * PI),
+            },
             other => panic!("unknown effect {other}; known: {:?}", Effect::NAMES),
         }
     }
@@ -355,6 +397,10 @@ impl Effect {
             Effect::PwmAlias { a, .. } => a,
             Effect::SpeedCrosstalk { kappa } => kappa,
             Effect::DcLinkResonance { z, .. } => z,
+            Effect::PumpThreshold { a, .. }
+            | Effect::HydraulicLoad { a, .. }
+            | Effect::EncoderGlitch { a, .. } => a,
+            Effect::CommutatorRipple { eps, .. } => eps,
         }
     }
 
@@ -397,6 +443,10 @@ impl Effect {
             Effect::PwmAlias { a, .. } => *a = s,
             Effect::SpeedCrosstalk { kappa } => *kappa = s,
             Effect::DcLinkResonance { z, .. } => *z = s,
+            Effect::PumpThreshold { a, .. }
+            | Effect::HydraulicLoad { a, .. }
+            | Effect::EncoderGlitch { a, .. } => *a = s,
+            Effect::CommutatorRipple { eps, .. } => *eps = s,
         }
         e
     }
@@ -437,6 +487,9 @@ impl Effect {
             Effect::ClutchEngagement { .. } => 1.0,
             Effect::PwmAlias { .. } => 50.0,
             Effect::DcLinkResonance { .. } => 0.5,
+            // A miscount of at most 1000 rad/s; a flux ripple of at most half.
+            Effect::EncoderGlitch { .. } => 1000.0,
+            Effect::CommutatorRipple { .. } => 0.5,
             _ => 1.0,
         }
     }
@@ -608,6 +661,18 @@ fn rhs(
             dx[3] = (x[2] - duty * i) / c;
             u += duty * x[3];
         }
+        Some(&Effect::PumpThreshold { a, share }) => {
+            let omega_0 = share * input.level / m.c_m;
+            torque -= a * (w - omega_0).max(0.0).powi(2);
+        }
+        Some(&Effect::HydraulicLoad { a, tau_p }) => {
+            torque -= a * x[2];
+            dx[2] = (w - x[2]) / tau_p;
+        }
+        Some(&Effect::CommutatorRipple { eps, k, phase }) => {
+            flux = 1.0 + eps * (k as f64 * x[2] + phase).sin();
+            dx[2] = w;
+        }
         // The angle, which the tacho's ripple reads.
         Some(Effect::TachoRipple { .. }) => dx[2] = w,
         // These act on what is measured (`measured`, `simulate`), not on the motor.
@@ -620,7 +685,8 @@ fn rhs(
             | Effect::MainsPickup { .. }
             | Effect::EncoderLatency { .. }
             | Effect::PwmAlias { .. }
-            | Effect::SpeedCrosstalk { .. },
+            | Effect::SpeedCrosstalk { .. }
+            | Effect::EncoderGlitch { .. },
         )
         | None => {}
     }
@@ -691,6 +757,11 @@ fn simulate(m: &Motor, e: Option<&Effect>, input: &Input, times: &[f64]) -> Vec<
                 let (a, b) = (history[j - 1], history[j]);
                 a.1 + (b.1 - a.1) * (late - a.0) / (b.0 - a.0)
             };
+        }
+        if let Some(&Effect::EncoderGlitch { a, salt }) = e
+            && let Some(sign) = glitch(salt, out.len())
+        {
+            y[1] += sign * a;
         }
         if let Some(&Effect::LeakageCurrent { g }) = e {
             y[0] += g * input.at(t, times);
@@ -836,6 +907,16 @@ fn expected(e: &Effect, input_level: f64) -> String {
             let (fr, zr) = dc_link_ringing(z, f, zeta, 24.0 / 30.0);
             format!(r#"{{"kind": "oscillation", "frequency_hz": {fr}, "damping_ratio": {zr}, "channel": "I", "ringing": true}}"#)
         }
+        // The pump's torque is a function of ω alone (a hinge no dictionary function has; its
+        // powers of ω approach it), in the torque balance.
+        Effect::PumpThreshold { .. } => r#"{"kind": "state", "balance": "torque", "functions": ["omega", "omega*|omega|", "omega^3"]}"#.into(),
+        // The pressure is a state of its own, the speed's history: no function of the state.
+        Effect::HydraulicLoad { .. } => r#"{"kind": "unknown"}"#.into(),
+        // Isolated miscounts follow nothing: something is left on ω that nothing names.
+        Effect::EncoderGlitch { .. } => r#"{"kind": "unknown", "channel": "omega"}"#.into(),
+        // The flux's ripple in both balances (as flux_saturation's): the kind, the angle and
+        // the order are asked.
+        Effect::CommutatorRipple { k, .. } => format!(r#"{{"kind": "state", "functions": ["omega*sin(k*theta)", "omega*cos(k*theta)", "I*sin(k*theta)", "I*cos(k*theta)"], "k": {k}}}"#),
         // The torque lost, ε·sin(kθ + φ)·c_g·I, as the law's two coefficients (c_g the nominal's,
         // which the truth keeps).
         Effect::LoadRipple { eps, k, phase } => format!(
