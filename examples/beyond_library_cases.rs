@@ -207,7 +207,8 @@ fn glitch(salt: u64, k: usize) -> Option<f64> {
     z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
     z ^= z >> 31;
-    (z % 100 == 0).then(|| if (z >> 40) & 1 == 1 { 1.0 } else { -1.0 })
+    z.is_multiple_of(100)
+        .then(|| if (z >> 40) & 1 == 1 { 1.0 } else { -1.0 })
 }
 
 impl Effect {
