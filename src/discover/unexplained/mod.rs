@@ -8,7 +8,8 @@
 //! τ (an input delay), one channel filtered with time constant τ (a sensor lag) and with a
 //! second-order filter that rings (a resonant sensor, `resonance`), a channel that runs ahead
 //! of the model (its derivative with a lead's sign: generic, no sensor leads, but a balance
-//! whose fast dynamics the model has too slow looks so), and the state fingerprints of the
+//! whose fast dynamics the model has too slow looks so), isolated samples far off (a
+//! contaminated normal of one channel's residual, `outliers`), and the state fingerprints of the
 //! balances and of what is read (`state`). Each is
 //! scored as the ranking scores a term: its linearised gain in log likelihood with the model's
 //! parameters refitted beside it (`regression`), less ½·ln N per degree of freedom, less the
@@ -34,6 +35,7 @@ mod figure;
 mod fingerprint;
 mod order;
 mod oscillation;
+mod outliers;
 mod quantized;
 mod reading;
 mod regression;
@@ -58,7 +60,6 @@ use super::settings::EVIDENCE_THRESHOLD;
 pub use as_given::AsGiven;
 pub use figure::{FOLDED_BINS, Folded, UnexplainedFigure};
 pub use fingerprint::{EquationTerm, Fingerprint, LawFunction, equation_with, with_shapes};
-use oscillation::Oscillation;
 pub use oscillation::{frequency_search_cost, lowest_frequency_over};
 use regression::{Explained, Projector, explain};
 pub use spans::Span;
@@ -265,13 +266,15 @@ struct Generic {
 }
 
 /// What a generic alternative is: it can hold "anything" of its shape.
-#[derive(Clone, Copy, PartialEq)]
+#[derive(Clone, PartialEq)]
 enum GenericKind {
     /// A Legendre polynomial in time (the report's `where` is read off the best one).
     Polynomial,
     Autoregression,
     /// The channel's derivative with a lead's sign: the channel runs ahead of the model.
     Lead,
+    /// Isolated samples far off, following nothing (`outliers`): the samples flagged.
+    Outliers(Vec<usize>),
 }
 
 /// The verdict's report: `null` in the JSON when nothing is left.
@@ -357,12 +360,19 @@ fn scores(ctx: &Context, shift: f64) -> Scores {
         }
         for o in oscillation::search(ctx, c) {
             fingerprints.push(Evidence {
-                fingerprint: oscillation_fingerprint(&o, &name, shift),
+                fingerprint: o.fingerprint(&name, shift),
                 residual: ctx.y.as_slice().to_vec(),
                 explained: o.scored.explained.fitted.as_slice().to_vec(),
             });
         }
         fingerprints.extend(quantized::evidence(ctx, c, shift));
+        if let Some(o) = outliers::evidence(ctx, c) {
+            generic.push(Generic {
+                channel: c,
+                kind: GenericKind::Outliers(o.samples),
+                scored: o.scored,
+            });
+        }
         // A lag: y_measured ≈ ŷ − τ·dŷ/dt on this channel alone (τ > 0), then fitted exactly.
         let d = DMatrix::from_column_slice(n, 1, &ctx.derivative(c));
         let s = ctx.score(&ctx.in_channel(c, &d), 0.0);
@@ -423,19 +433,6 @@ fn scores(ctx: &Context, shift: f64) -> Scores {
     Scores {
         fingerprints,
         generic,
-    }
-}
-
-fn oscillation_fingerprint(o: &Oscillation, channel: &str, shift: f64) -> Fingerprint {
-    Fingerprint::Oscillation {
-        frequency_hz: o.frequency_hz,
-        frequency_sd: o.frequency_sd,
-        damping_ratio: o.damping_ratio(),
-        channel: channel.to_string(),
-        ringing: o.ringing(),
-        sensor: false,
-        score: o.scored.score - shift,
-        frequencies: o.frequencies,
     }
 }
 
@@ -571,6 +568,10 @@ pub fn unexplained(
     }
     let mut suggestion = fingerprint.suggestion(&channels);
     if let (Fingerprint::Unknown { .. }, Some(g)) = (&fingerprint, best_generic)
+        && let GenericKind::Outliers(samples) = &g.kind
+    {
+        (where_, suggestion) = outliers::reported(&ctx, g.channel, samples);
+    } else if let (Fingerprint::Unknown { .. }, Some(g)) = (&fingerprint, best_generic)
         && g.kind == GenericKind::Lead
     {
         suggestion = format!(

@@ -13,7 +13,7 @@ use rayon::prelude::*;
 #[cfg(test)]
 use super::regression::gain;
 use super::regression::{explain, gain_from_normal_equations, golden_max};
-use super::{Context, Scored};
+use super::{Context, Fingerprint, Scored};
 use crate::study::frequency_grid::grid_over;
 pub use crate::study::frequency_grid::{frequency_search_cost, lowest_frequency_over};
 
@@ -40,6 +40,20 @@ pub struct Oscillation {
 impl Oscillation {
     pub fn ringing(&self) -> bool {
         self.decay.is_some()
+    }
+
+    /// The fingerprint it gives on `channel`, scored against a bar raised by `shift` nats.
+    pub fn fingerprint(&self, channel: &str, shift: f64) -> Fingerprint {
+        Fingerprint::Oscillation {
+            frequency_hz: self.frequency_hz,
+            frequency_sd: self.frequency_sd,
+            damping_ratio: self.damping_ratio(),
+            channel: channel.to_string(),
+            ringing: self.ringing(),
+            sensor: false,
+            score: self.scored.score - shift,
+            frequencies: self.frequencies,
+        }
     }
 
     /// ζ of a ringing oscillation: λ = ζ·ω_n, ω_d = ω_n·√(1 − ζ²).
