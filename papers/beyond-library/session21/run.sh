@@ -59,3 +59,17 @@ done
 python3 $B/session12/compare_full.py $S/real/base $S/real/new > $HERE/compare-full-real-23b443b-session21.txt
 # 6. (issue 20) The position loop's pinned sds over 50 records per input.
 BIN=$BIN_new W=$S/pinmany50 papers/design/position-loop/pin-many.sh > papers/design/position-loop/pin-many.txt
+# 7. Fresh miscount cases, made after the alternative was written: twelve at seeds 800000,
+#    both builds, whole commands; what each names against the true miscounts.
+$GEN --out $S/h80 --effects encoder_glitch --per-effect 12 --seed-base 800000 > $HERE/cases-800000.log
+for V in base:r80 new:n80; do eval BIN=\$BIN_${V%%:*}; R=$S/${V##*:}; mkdir -p $R
+  for C in $S/h80/*/; do N=$(basename $C)
+    $BIN diagnose --quiet --data $C/recording.csv --model $C/motor.toml --json $R/$N.json --out $R/$N.d > $R/$N.log 2>&1
+  done
+done
+python3 $HERE/outlier_table.py $S/h80 $S/r80 > $HERE/outlier-table-800000-23b443b.txt
+python3 $HERE/outlier_table.py $S/h80 $S/n80 > $HERE/outlier-table-800000-session21.txt
+python3 $HERE/oracle_outliers.py $S/h80/*/ > $HERE/oracle-outliers-800000.txt
+# 8. A hundred fresh null cases (seeds 1700000) for the verdict's false alarms.
+$STUDY --per-effect 0 --null 100 --two 0 --no-dev --seed-base 1700000 --out $S/null17 > $B/null-1700000-session21/log.txt
+cp $S/null17/study.csv $S/null17/study.json $B/null-1700000-session21/
