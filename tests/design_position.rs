@@ -323,3 +323,116 @@ fn a_library_design_keeps_a_position_loop_under_its_saturation_unless_told() {
     assert!(force <= design::MARGIN * 351.5, "|force| reaches {force} N");
     assert!(d.check.within_limits);
 }
+
+/// The fixture with the initial position's offset calibrated beside J and d, in `dir`.
+fn with_initial_offset(dir: &Path) -> PathBuf {
+    let text = std::fs::read_to_string(model_path()).unwrap() + "q0_offset = {}\n";
+    let path = dir.join("position_loop_q0.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// A reference ramping at 2 cm/s from rest, sampled at 1 kHz over 0.5 s, as `t,q_ref`.
+fn ramp(dir: &Path) -> PathBuf {
+    let mut text = String::from("t,q_ref\n");
+    for k in 1..=500 {
+        let t = k as f64 * 1e-3;
+        text.push_str(&format!("{t},{}\n", 0.02 * (t - 1e-3)));
+    }
+    let path = dir.join("ramp.csv");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// The axis's initial position is the first measured q, and that sample's noise moved J's
+/// MAP with it (`papers/design.md`, "Over many records": J spread 1.2–1.6 times its posterior
+/// sd over 50 records). The offset `q0_offset` takes it out. It is a parameter like any
+/// other: its sensitivities are the derivatives of the sampled solve (central differences),
+/// and calibrated on a record it puts the axis where it started (at rest, at the reference's
+/// first value) to within three of its sds, sds under half a sample's noise.
+#[test]
+fn the_initial_position_offset_is_differentiated_and_calibrated_back_to_where_the_axis_started() {
+    use motorcal::ode::SolverSettings;
+    use motorcal::study::Problem;
+    let dir = scratch("design-position", "initial-offset");
+    let model = with_initial_offset(&dir);
+    let recording = simulate(&model_path(), &ramp(&dir), NOISE, "31", &dir.join("rec"));
+    let problem = Problem::from_files(std::slice::from_ref(&recording), &model).unwrap();
+    let forward = problem.forward(SolverSettings::default()).unwrap();
+    let names = forward.calibrated_names();
+    let at = names
+        .iter()
+        .position(|n| n == "q0_offset")
+        .expect("calibrated");
+    let mut theta = forward.nominal_calibrated();
+    theta[at] = 1.5e-6;
+    let n = forward.n_outputs();
+    let mut values = vec![0.0; n];
+    let mut jacobian = nalgebra::DMatrix::zeros(n, theta.len());
+    forward
+        .simulate_with_sensitivities(&theta, &mut values, &mut jacobian)
+        .unwrap();
+    for k in 0..theta.len() {
+        let h = if k == at { 1e-7 } else { 1e-6 * theta[k].abs() };
+        let (mut up, mut down) = (theta.clone(), theta.clone());
+        up[k] += h;
+        down[k] -= h;
+        let (mut vu, mut vd) = (vec![0.0; n], vec![0.0; n]);
+        forward.simulate(&up, &mut vu).unwrap();
+        forward.simulate(&down, &mut vd).unwrap();
+        let scale = jacobian.column(k).amax();
+        assert!(scale > 0.0, "{}: no sensitivity", names[k]);
+        for row in 0..n {
+            let fd = (vu[row] - vd[row]) / (2.0 * h);
+            assert!(
+                (fd - jacobian[(row, k)]).abs() < 1e-5 * scale,
+                "{}, output {row}: {fd} vs {}",
+                names[k],
+                jacobian[(row, k)]
+            );
+        }
+    }
+    let out = dir.join("fit");
+    run(&[
+        "fit",
+        "--data",
+        recording.to_str().unwrap(),
+        "--model",
+        model.to_str().unwrap(),
+        "--bm",
+        "1",
+        "--map-only",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let fit = json(&out.join("fit.json"));
+    let offset = fit["map"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|p| p["name"] == "q0_offset")
+        .expect("q0_offset in the MAP")
+        .clone();
+    let (value, sd) = (
+        offset["value"].as_f64().unwrap(),
+        offset["laplace_sd"].as_f64().unwrap(),
+    );
+    let first: f64 = std::fs::read_to_string(&recording)
+        .unwrap()
+        .lines()
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .nth(1)
+        .unwrap()
+        .parse()
+        .unwrap();
+    let started = first + value;
+    eprintln!("first q {first:e}, offset {value:e} ± {sd:e}: start {started:e}");
+    assert!(sd < 1e-6, "sd {sd:e} against σ_q 2e-6");
+    assert!(
+        started.abs() < 3.0 * sd,
+        "started at {started:e} ± {sd:e}, not 0"
+    );
+}

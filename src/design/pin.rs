@@ -184,6 +184,21 @@ pub fn pinned(
         grads.push(g);
         values.push(value);
     }
+    // In the basis where each parameter's own information is one: a parameter known to a
+    // micrometre (a position offset) beside one known to a kilogram would otherwise put the
+    // second's eigenvalue under the tolerance of the first's.
+    let scale: Vec<f64> = (0..d)
+        .map(|i| {
+            let fii = f[(i, i)];
+            if fii > 0.0 { 1.0 / fii.sqrt() } else { 1.0 }
+        })
+        .collect();
+    let f = DMatrix::from_fn(d, d, |i, j| f[(i, j)] * scale[i] * scale[j]);
+    for g in &mut grads {
+        for (gi, si) in g.iter_mut().zip(&scale) {
+            *gi *= si;
+        }
+    }
     let eig = f.symmetric_eigen();
     let top = eig.eigenvalues.iter().fold(0.0f64, |a, &l| a.max(l));
     let mut cov = DMatrix::<f64>::zeros(targets.len(), targets.len());

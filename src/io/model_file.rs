@@ -285,6 +285,11 @@ pub fn to_toml_string(model: &ModelFile) -> String {
     }
     out.push_str("\n[motor]\n");
     for p in MotorParam::ALL {
+        // Only a position loop's record has an initial position to offset: the key is written
+        // where it is set, so that the other files read as they always have.
+        if p == MotorParam::InitialPositionOffset && model.motor.get(p) == 0.0 {
+            continue;
+        }
         out.push_str(&format!(
             "{} = {}\n",
             p.key(),

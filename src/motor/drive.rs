@@ -155,7 +155,9 @@ pub(super) fn simulate<D: Scalar>(
     let m = drive.times.len();
     let mut y0 = vec![D::from(0.0); model.n_states()];
     model.initial_state(p, &mut y0);
-    y0[0] = D::from(drive.initial_position);
+    // The first measured position carries its sample's noise; the offset, when calibrated,
+    // takes it back out.
+    y0[0] = D::from(drive.initial_position) + p[MotorParam::InitialPositionOffset as usize];
     let substeps = drive.settings.substeps;
     match model.base {
         Base::PositionLoop => {
@@ -164,7 +166,7 @@ pub(super) fn simulate<D: Scalar>(
             let (positions, forces) = out.split_at_mut(m);
             let limit = drive.input_scale();
             // The last three positions the controller saw, and its last `delay + 1` outputs.
-            let mut seen = [D::from(drive.initial_position); 3];
+            let mut seen = [y0[0]; 3];
             let mut pending = vec![D::from(0.0); delay + 1];
             solve_sampled(&system, &y0, &drive.times, substeps, |k, y| {
                 seen = [y[0], seen[0], seen[1]];

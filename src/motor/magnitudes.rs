@@ -137,6 +137,12 @@ fn base_spec(p: MotorParam, nominal: f64, m: &Magnitudes) -> ParameterSpec {
         Voltage => (Support::Real, normal(PRIOR_SHARE * m.voltage)),
         InitialCurrent => (Support::Real, normal(PRIOR_SHARE * m.current)),
         InitialSpeed => (Support::Real, normal(PRIOR_SHARE * m.speed)),
+        // What a speed covers in a mechanical time constant: wide against a sample's noise,
+        // which is all the offset is there to hold.
+        InitialPositionOffset => (
+            Support::Real,
+            normal(PRIOR_SHARE * m.speed * m.mechanical_time),
+        ),
     };
     ParameterSpec {
         id: ParamId::base(p.key()),

@@ -14,10 +14,13 @@ pub enum MotorParam {
     Inertia,
     InitialCurrent,
     InitialSpeed,
+    /// A position loop's initial position, as an offset from the record's first measured q
+    /// (which carries that sample's noise): 0 takes the sample as it is.
+    InitialPositionOffset,
 }
 
 impl MotorParam {
-    pub const ALL: [MotorParam; 9] = [
+    pub const ALL: [MotorParam; 10] = [
         MotorParam::Resistance,
         MotorParam::BackEmfConstant,
         MotorParam::TorqueConstant,
@@ -27,6 +30,7 @@ impl MotorParam {
         MotorParam::Inertia,
         MotorParam::InitialCurrent,
         MotorParam::InitialSpeed,
+        MotorParam::InitialPositionOffset,
     ];
 
     /// The key in model files and in output column names (the paper's symbols).
@@ -41,6 +45,7 @@ impl MotorParam {
             MotorParam::Inertia => "J",
             MotorParam::InitialCurrent => "I0",
             MotorParam::InitialSpeed => "omega0",
+            MotorParam::InitialPositionOffset => "q0_offset",
         }
     }
 
@@ -55,6 +60,7 @@ impl MotorParam {
             MotorParam::Inertia => "kg·m²",
             MotorParam::InitialCurrent => "A",
             MotorParam::InitialSpeed => "rad/s",
+            MotorParam::InitialPositionOffset => "m",
         }
     }
 
@@ -106,6 +112,9 @@ pub struct MotorParameters {
     /// Initial speed ω(0) [rad/s].
     #[serde(rename = "omega0")]
     pub initial_speed: f64,
+    /// A position loop's initial position less the record's first measured q [m].
+    #[serde(rename = "q0_offset")]
+    pub initial_position_offset: f64,
 }
 
 impl Default for MotorParameters {
@@ -123,6 +132,7 @@ impl Default for MotorParameters {
             load_torque: 0.0,
             initial_current: 0.0,
             initial_speed: 0.0,
+            initial_position_offset: 0.0,
         }
     }
 }
@@ -147,6 +157,7 @@ impl MotorParameters {
             MotorParam::Inertia => self.inertia,
             MotorParam::InitialCurrent => self.initial_current,
             MotorParam::InitialSpeed => self.initial_speed,
+            MotorParam::InitialPositionOffset => self.initial_position_offset,
         }
     }
 
@@ -161,6 +172,7 @@ impl MotorParameters {
             MotorParam::Inertia => &mut self.inertia,
             MotorParam::InitialCurrent => &mut self.initial_current,
             MotorParam::InitialSpeed => &mut self.initial_speed,
+            MotorParam::InitialPositionOffset => &mut self.initial_position_offset,
         };
         *slot = value;
     }
