@@ -58,7 +58,11 @@ for V in base new; do eval BIN=\$BIN_$V; mkdir -p $S/real/$V
 done
 python3 $B/session12/compare_full.py $S/real/base $S/real/new > $HERE/compare-full-real-23b443b-session21.txt
 # 6. (issue 20) The position loop's pinned sds over 50 records per input.
-BIN=$BIN_new W=$S/pinmany50 papers/design/position-loop/pin-many.sh > papers/design/position-loop/pin-many.txt
+#    BIN_q0 a build of a316337 (q0_offset); the first run is the fixture as it is, the second
+#    calibrates the offset.
+BIN=$BIN_q0 W=$S/pm-a papers/design/position-loop/pin-many.sh > papers/design/position-loop/pin-many.txt
+FIX=papers/design/position-loop/position_loop_q0.toml BIN=$BIN_q0 W=$S/pm-b \
+    papers/design/position-loop/pin-many.sh > papers/design/position-loop/pin-many-q0.txt
 # 7. Fresh miscount cases, made after the alternative was written: twelve at seeds 800000,
 #    both builds, whole commands; what each names against the true miscounts.
 $GEN --out $S/h80 --effects encoder_glitch --per-effect 12 --seed-base 800000 > $HERE/cases-800000.log

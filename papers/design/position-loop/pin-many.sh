@@ -4,13 +4,14 @@
 # input (the designed one and the three fixed), RECORDS records (seeds 9001…) are simulated and
 # fitted by `motorcal fit --map-only` (BM1). Printed per input: the sd over the records of the
 # MAP J and d (the sampling spread the expected sd predicts), and the mean Laplace sd (the
-# posterior width each record shows), each over design.json's expected sd. BIN a build of the
-# commit named in papers/design.md.
+# posterior width each record shows), each over design.json's expected sd. FIX the model
+# (default the fixture; a copy with `q0_offset = {}` under [calibrate] calibrates the initial
+# position's offset). BIN a build of the commit named in papers/design.md.
 set -e
 BIN=${BIN:-motorcal}
 RECORDS=${RECORDS:-50}
 HERE=$(cd "$(dirname "$0")" && pwd); ROOT=$HERE/../../..
-FIX=$ROOT/tests/fixtures/design/position_loop.toml
+FIX=${FIX:-$ROOT/tests/fixtures/design/position_loop.toml}
 W=${W:-/tmp/design-position-many}
 rm -rf $W; mkdir -p $W
 $BIN design --model $FIX --pin J,d --duration 1 --rate 1000 --limits q=±0.1,omega=±0.5,force=±300 \
@@ -70,6 +71,22 @@ for name in expected:
         return num / math.sqrt(sum((x - ma) ** 2 for x in a) * sum((y - mb) ** 2 for y in b))
     label = "designed" if name == "input" else name[len("fixed-"):]
     print(f"| {label} | {corr(first, found['J']):.3f} | {corr(first, found['d']):.3f} |")
+# Where the model puts the axis at its first sample: the first measured q, plus the offset
+# where the model calibrates q0_offset (the truth starts at rest at the reference's 0).
+print("\n| input | start: mean | sd over the records | mean Laplace sd of q0_offset | sd of the first measured q |")
+print("|---|---|---|---|---|")
+for name in expected:
+    start, width, first = [], [], []
+    for k in range(1, records + 1):
+        row = next(csv.DictReader(open(f"{w}/{name}-{9000 + k}-rec/recording.csv")))
+        offset = [p for p in json.load(open(f"{w}/{name}-{9000 + k}-fit/fit.json"))["map"]
+                  if p["name"] == "q0_offset"]
+        first.append(float(row["q"]))
+        start.append(first[-1] + (offset[0]["value"] if offset else 0.0))
+        width.append(offset[0]["laplace_sd"] if offset else 0.0)
+    label = "designed" if name == "input" else name[len("fixed-"):]
+    print(f"| {label} | {statistics.mean(start):.3g} | {statistics.stdev(start):.3g} | "
+          f"{statistics.mean(width):.3g} | {statistics.stdev(first):.3g} |")
 # The sd of a sample sd of n normal draws is about sd/√(2(n−1)): the spread's ratio is known to
 # within that share.
 print(f"\nthe sd of the MAPs' sd over {records} records is known to ±{1 / math.sqrt(2 * (records - 1)):.1%} (one sd)")
