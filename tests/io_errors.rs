@@ -205,6 +205,19 @@ fn bad_model_files_are_located() {
             3,
             "motor.R",
         ),
+        // Only a position loop has an initial position to offset.
+        (
+            "q0_offset_voltage.toml",
+            "[motor]\nR = 0.1\nq0_offset = 1e-6\n",
+            3,
+            "motor.q0_offset",
+        ),
+        (
+            "q0_offset_calibrated_current.toml",
+            "schema = 2\nbase = \"current_driven\"\n[motor]\nJ = 1e-4\n[calibrate]\nJ = {}\nq0_offset = {}\n",
+            7,
+            "calibrate.q0_offset",
+        ),
     ];
     for &(name, contents, line, field) in cases {
         let path = put(&dir, name, contents);

@@ -252,6 +252,30 @@ pub fn parse_model_file(text: &str, path: &Path) -> Result<ModelFile, InputError
             .at_line_opt(line_of(&key).or_else(|| line_of("drive")))
             .for_field(key));
     }
+    let q0 = MotorParam::InitialPositionOffset.key();
+    let calibrates_q0 = model
+        .calibrate
+        .iter()
+        .flatten()
+        .any(|c| c.id == ParamId::base(q0));
+    if model.base != Base::PositionLoop
+        && (model.motor.initial_position_offset != 0.0 || calibrates_q0)
+    {
+        let field = if calibrates_q0 {
+            format!("calibrate.{q0}")
+        } else {
+            format!("motor.{q0}")
+        };
+        return Err(InputError::new(
+            path,
+            format!(
+                "{q0} is a position loop's initial position; a {} model has none",
+                model.base.name()
+            ),
+        )
+        .at_line_opt(line_of(&field))
+        .for_field(field));
+    }
     if let Err(message) = model.motor.validate() {
         // validate() reports "KEY = value ..."; the key tells which line to point at.
         let key = message
