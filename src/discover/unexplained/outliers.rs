@@ -3,7 +3,7 @@
 //!
 //! Such samples hold no law of the state or of time, so no other alternative here holds them:
 //! the polynomial and the autoregression spread them over the record, and a large one after a
-//! quiet stretch reads as a ringing (encoder_glitch-790012, spikes of 14.6 σ taken for a
+//! quiet stretch reads as a ringing (encoder_glitch-790012, spikes of 14.9 σ taken for a
 //! 350-Hz resonance). The alternative asked here is the noise itself: the channel's whitened
 //! residual as a contaminated normal, (1 − ε)·N(0, a²) + ε·N(0, b²), against the single normal
 //! the model assumes, both by maximum likelihood (two-component EM, the core's scale a the
