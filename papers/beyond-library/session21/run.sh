@@ -3,7 +3,7 @@
 # beyond_library_cases of 21070df (the eighth set added); LIBRES the example library_residual;
 # BIN_base a build of 23b443b (session 20's last commit), BIN_new of this session's source (the
 # outliers' alternative, src/discover/unexplained/outliers.rs); STUDY diagnose_study of BIN_new's
-# source. oracle_outliers.py needs only the standard library.
+# source; BIN_final a build of cda1b10 or later. oracle_outliers.py needs only the standard library.
 set -e
 HERE=papers/beyond-library/session21; B=papers/beyond-library; S=/tmp/s21
 # 1. The eighth set of effects not built for, made and diagnosed blind by the base (whole
@@ -77,3 +77,8 @@ python3 $HERE/oracle_outliers.py $S/h80/*/ > $HERE/oracle-outliers-800000.txt
 # 8. A hundred fresh null cases (seeds 1700000) for the verdict's false alarms.
 $STUDY --per-effect 0 --null 100 --two 0 --no-dev --seed-base 1700000 --out $S/null17 > $B/null-1700000-session21/log.txt
 cp $S/null17/study.csv $S/null17/study.json $B/null-1700000-session21/
+# 9. (issue 20) EMPS's record with and without the initial position's offset calibrated.
+(echo '$ motorcal fit --data ../shared/data/real/emps/emps_estimation.csv --model examples/emps/model.toml --bm 1 --map-only --quiet --out /tmp/emps-a'
+ $BIN_final fit --data ../shared/data/real/emps/emps_estimation.csv --model examples/emps/model.toml --bm 1 --map-only --quiet --out /tmp/emps-a 2>&1; echo
+ echo '$ motorcal fit --data ../shared/data/real/emps/emps_estimation.csv --model papers/design/position-loop/emps_q0.toml --bm 1 --map-only --quiet --out /tmp/emps-b'
+ $BIN_final fit --data ../shared/data/real/emps/emps_estimation.csv --model papers/design/position-loop/emps_q0.toml --bm 1 --map-only --quiet --out /tmp/emps-b 2>&1) > papers/design/position-loop/emps-q0.txt
