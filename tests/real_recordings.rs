@@ -4,10 +4,12 @@
 //! window of each rig (CI) and on the whole records (`#[ignore]`, run before resolving; their
 //! results are in papers/real-recordings.md). Skipped with a message when the data are absent.
 
+mod sensitivity_support;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use nalgebra::DMatrix;
+use sensitivity_support::assert_sensitivities_are_central_differences;
 
 use motorcal::discover::{Diagnosis, DiscoverSettings, discover, records_reverse};
 use motorcal::error::Error;
@@ -167,30 +169,9 @@ fn drive_sensitivities_are_the_derivatives_of_the_sampled_solve() {
     let problem = Problem::from_files(&[data], &model).unwrap();
     let forward = problem.forward(SolverSettings::default()).unwrap();
     let theta = vec![95.0, 205.0, 0.004, 20.0, -3.0];
-    let n = forward.n_outputs();
-    let mut values = vec![0.0; n];
-    let mut jacobian = DMatrix::zeros(n, theta.len());
-    forward
-        .simulate_with_sensitivities(&theta, &mut values, &mut jacobian)
-        .unwrap();
-    for k in 0..theta.len() {
-        let h = 1e-6 * theta[k].abs().max(1e-3);
-        let (mut up, mut down) = (theta.clone(), theta.clone());
-        up[k] += h;
-        down[k] -= h;
-        let (mut vu, mut vd) = (vec![0.0; n], vec![0.0; n]);
-        forward.simulate(&up, &mut vu).unwrap();
-        forward.simulate(&down, &mut vd).unwrap();
-        let scale = jacobian.column(k).amax().max(1e-12);
-        for row in 0..n {
-            let fd = (vu[row] - vd[row]) / (2.0 * h);
-            assert!(
-                (fd - jacobian[(row, k)]).abs() < 1e-5 * scale,
-                "parameter {k}, output {row}: {fd} vs {}",
-                jacobian[(row, k)]
-            );
-        }
-    }
+    assert_sensitivities_are_central_differences(&forward, &theta, |k| {
+        1e-6 * theta[k].abs().max(1e-3)
+    });
 }
 
 #[test]
