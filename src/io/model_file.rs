@@ -252,29 +252,31 @@ pub fn parse_model_file(text: &str, path: &Path) -> Result<ModelFile, InputError
             .at_line_opt(line_of(&key).or_else(|| line_of("drive")))
             .for_field(key));
     }
-    let q0 = MotorParam::InitialPositionOffset.key();
-    let calibrates_q0 = model
-        .calibrate
-        .iter()
-        .flatten()
-        .any(|c| c.id == ParamId::base(q0));
-    if model.base != Base::PositionLoop
-        && (model.motor.initial_position_offset != 0.0 || calibrates_q0)
-    {
-        let field = if calibrates_q0 {
-            format!("calibrate.{q0}")
-        } else {
-            format!("motor.{q0}")
+    // A parameter of one base alone (a position loop's initial offset) is set or calibrated
+    // only on that base.
+    for p in MotorParam::ALL {
+        let Some(base) = p.only_on().filter(|&b| b != model.base) else {
+            continue;
         };
-        return Err(InputError::new(
-            path,
-            format!(
-                "{q0} is a position loop's initial position; a {} model has none",
-                model.base.name()
-            ),
-        )
-        .at_line_opt(line_of(&field))
-        .for_field(field));
+        let key = p.key();
+        let calibrated = model
+            .calibrate
+            .iter()
+            .flatten()
+            .any(|c| c.id == ParamId::base(key));
+        if model.motor.get(p) != 0.0 || calibrated {
+            let field = format!("{}.{key}", if calibrated { "calibrate" } else { "motor" });
+            return Err(InputError::new(
+                path,
+                format!(
+                    "{key} is a parameter of a {} model only; this one is {}",
+                    base.name(),
+                    model.base.name()
+                ),
+            )
+            .at_line_opt(line_of(&field))
+            .for_field(field));
+        }
     }
     if let Err(message) = model.motor.validate() {
         // validate() reports "KEY = value ..."; the key tells which line to point at.
@@ -309,9 +311,9 @@ pub fn to_toml_string(model: &ModelFile) -> String {
     }
     out.push_str("\n[motor]\n");
     for p in MotorParam::ALL {
-        // Only a position loop's record has an initial position to offset: the key is written
-        // where it is set, so that the other files read as they always have.
-        if p == MotorParam::InitialPositionOffset && model.motor.get(p) == 0.0 {
+        // A parameter of one base alone is written where it is set, so that the other files
+        // read as they always have.
+        if p.only_on().is_some() && model.motor.get(p) == 0.0 {
             continue;
         }
         out.push_str(&format!(

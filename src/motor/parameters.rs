@@ -2,6 +2,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::Base;
+
 /// One physical parameter of the motor; the discriminant is its place in the parameter vector.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum MotorParam {
@@ -66,6 +68,15 @@ impl MotorParam {
 
     pub fn from_key(key: &str) -> Option<MotorParam> {
         MotorParam::ALL.into_iter().find(|p| p.key() == key)
+    }
+
+    /// The one base a parameter belongs to (`None`: every base's): a position loop's initial
+    /// offset, which no other base has a measured position for.
+    pub fn only_on(self) -> Option<Base> {
+        match self {
+            MotorParam::InitialPositionOffset => Some(Base::PositionLoop),
+            _ => None,
+        }
     }
 
     /// Parameters that divide the right-hand side or are physically positive.
