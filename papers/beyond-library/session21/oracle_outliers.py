@@ -9,17 +9,10 @@ record: the miss is spent on where the spikes are.
 
     oracle_outliers.py CASE_DIR ...
 """
-import csv, json, math, re, sys
+import csv, math, sys
 
-M = (1 << 64) - 1
+from miscounts import case_truth, miscounted
 
-
-def miscounted(salt, k):
-    z = salt ^ ((k * 0x9E3779B97F4A7C15) & M)
-    z = ((z ^ (z >> 30)) * 0xBF58476D1CE4E5B9) & M
-    z = ((z ^ (z >> 27)) * 0x94D049BB133111EB) & M
-    z ^= z >> 31
-    return z % 100 == 0
 
 
 def ln_normal(y, s):
@@ -58,9 +51,7 @@ pays = math.log(1002)
 print(f"| case | spikes | size (σ) | miss (nats) | oracle gain | less ln N ({pays:.2f}) |")
 print("|---|---|---|---|---|---|")
 for case in sys.argv[1:]:
-    answer = json.load(open(f"{case}/answer.json"))
-    salt = int(re.search(r"salt: (\d+)", answer["truth"]).group(1))
-    a = float(re.search(r"a: ([0-9.e+-]+)", answer["truth"]).group(1))
+    answer, salt, a = case_truth(case)
     rec, truth = rows(f"{case}/recording.csv"), rows(f"{case}/truth.csv")
     spikes = [k for k in range(len(rec)) if miscounted(salt, k)]
     y = [(r[1] - t[1]) / 10.0 for r, t in zip(rec, truth)]

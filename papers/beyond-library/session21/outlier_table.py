@@ -5,17 +5,10 @@ examples/beyond_library_cases.rs draws them) and how many miscounts it names.
 
     outlier_table.py CASES REPORTS    (REPORTS/CASE.json, `diagnose --json`)
 """
-import csv, glob, json, os, re, sys
+import csv, glob, json, os, sys
 
-M = (1 << 64) - 1
+from miscounts import case_truth, miscounted
 
-
-def miscounted(salt, k):
-    z = salt ^ ((k * 0x9E3779B97F4A7C15) & M)
-    z = ((z ^ (z >> 30)) * 0xBF58476D1CE4E5B9) & M
-    z = ((z ^ (z >> 27)) * 0x94D049BB133111EB) & M
-    z ^= z >> 31
-    return z % 100 == 0
 
 
 cases, reports = sys.argv[1], sys.argv[2]
@@ -25,9 +18,7 @@ named_total = right_total = found_total = all_total = 0
 kinds = {}
 for case in sorted(glob.glob(f"{cases}/encoder_glitch-*/")):
     name = os.path.basename(case.rstrip("/"))
-    answer = json.load(open(f"{case}/answer.json"))
-    salt = int(re.search(r"salt: (\d+)", answer["truth"]).group(1))
-    a = float(re.search(r"a: ([0-9.e+-]+)", answer["truth"]).group(1))
+    answer, salt, a = case_truth(case)
     times = [float(r["t"]) for r in csv.DictReader(open(f"{case}/recording.csv"))]
     truth = {round(times[k], 9) for k in range(len(times)) if miscounted(salt, k)}
     report = json.load(open(f"{reports}/{name}.json"))
