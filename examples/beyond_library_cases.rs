@@ -23,7 +23,8 @@
 //! `crank_inertia`; a sixth, `current_sensor_resonance`, `sensor_heat_drift`, `load_ramp`,
 //! `rotor_rub`; a seventh, `slew_limit`, `clutch_engagement`, `pwm_alias`, `speed_crosstalk`,
 //! `dc_link_resonance`; an eighth, `pump_threshold`, `hydraulic_load`, `encoder_glitch`,
-//! `commutator_ripple` (the last on slow records, `--volts 2`).
+//! `commutator_ripple` (the last on slow records, `--volts 2`); a ninth, `mount_resonance`,
+//! `speed_window`, `sensor_dropout`, `shorted_turn`.
 //!
 //! cargo run --release --example beyond_library_cases -- [--out DIR] [--per-effect 3]
 //!     [--seed-base 510000] [--min-nats 20] [--max-nats 300] [--effects a,b,…] [--volts 24]
@@ -199,6 +200,23 @@ enum Effect {
     /// 1 + ε·sin(kθ + φ), in the back-EMF and the torque alike (on slow records, `--volts 2`).
     /// `--effects commutator_ripple`.
     CommutatorRipple { eps: f64, k: u32, phase: f64 },
+    /// The motor's stator on a torsional mount (J_s = J/a, natural frequency f_s, damping
+    /// ratio ζ_s): the winding's torque twists it back, the encoder reads the rotor's speed
+    /// relative to the stator, and the back-EMF and the friction follow that relative speed.
+    /// The stator rests at the start and settles back: no inertia is added once it has.
+    /// `--effects mount_resonance`.
+    MountResonance { a: f64, f_s: f64, zeta_s: f64 },
+    /// The speed computed as the encoder's angle difference over a window T_w: what is read of
+    /// ω is its mean over the last T_w, a moving average (not a first-order filter).
+    /// `--effects speed_window`.
+    SpeedWindow { t_w: f64 },
+    /// The speed sensor's reading frozen at its last value over a span D from t_d (a cable's
+    /// intermittent contact). `--effects sensor_dropout`.
+    SensorDropout { d: f64, t_d: f64 },
+    /// A shorted turn (or a solid frame's eddy currents): a secondary loop of inductance L and
+    /// time constant τ_s, coupled to the winding by k = M/L, its current a hidden state that
+    /// opposes the winding's changes. `--effects shorted_turn`.
+    ShortedTurn { k: f64, tau_s: f64 },
 }
 
 /// Whether sample `k` is one the encoder miscounts, and the sign: splitmix64 of salt and k.
@@ -354,6 +372,20 @@ impl Effect {
                 k: rng.random_range(2..=5),
                 phase: rng.random_range(0.0..2.0 * PI),
             },
+            "mount_resonance" => Effect::MountResonance {
+                a: 0.1,
+                f_s: rng.random_range(40.0..250.0),
+                zeta_s: rng.random_range(0.05..0.2),
+            },
+            "speed_window" => Effect::SpeedWindow { t_w: 1e-3 },
+            "sensor_dropout" => Effect::SensorDropout {
+                d: 0.02,
+                t_d: rng.random_range(0.05..0.4),
+            },
+            "shorted_turn" => Effect::ShortedTurn {
+                k: 0.1,
+                tau_s: rng.random_range(2e-3..20e-3),
+            },
             other => panic!("unknown effect {other}; known: {:?}", Effect::NAMES),
         }
     }
@@ -402,6 +434,10 @@ impl Effect {
             | Effect::HydraulicLoad { a, .. }
             | Effect::EncoderGlitch { a, .. } => a,
             Effect::CommutatorRipple { eps, .. } => eps,
+            Effect::MountResonance { a, .. } => a,
+            Effect::SpeedWindow { t_w } => t_w,
+            Effect::SensorDropout { d, .. } => d,
+            Effect::ShortedTurn { k, .. } => k,
         }
     }
 
@@ -448,6 +484,10 @@ impl Effect {
             | Effect::HydraulicLoad { a, .. }
             | Effect::EncoderGlitch { a, .. } => *a = s,
             Effect::CommutatorRipple { eps, .. } => *eps = s,
+            Effect::MountResonance { a, .. } => *a = s,
+            Effect::SpeedWindow { t_w } => *t_w = s,
+            Effect::SensorDropout { d, .. } => *d = s,
+            Effect::ShortedTurn { k, .. } => *k = s,
         }
         e
     }
@@ -491,6 +531,12 @@ impl Effect {
             // A miscount of at most 1000 rad/s; a flux ripple of at most half.
             Effect::EncoderGlitch { .. } => 1000.0,
             Effect::CommutatorRipple { .. } => 0.5,
+            // A stator at least as heavy as the rotor; a window of at most 20 ms; a dropout of
+            // at most 100 ms; a coupling of at most 0.9.
+            Effect::MountResonance { .. } => 1.0,
+            Effect::SpeedWindow { .. } => 0.02,
+            Effect::SensorDropout { .. } => 0.1,
+            Effect::ShortedTurn { .. } => 0.9,
             _ => 1.0,
         }
     }
@@ -687,8 +733,12 @@ fn rhs(
             | Effect::EncoderLatency { .. }
             | Effect::PwmAlias { .. }
             | Effect::SpeedCrosstalk { .. }
-            | Effect::EncoderGlitch { .. },
+            | Effect::EncoderGlitch { .. }
+            | Effect::SpeedWindow { .. }
+            | Effect::SensorDropout { .. },
         )
+        // Their balances are rewritten below.
+        | Some(Effect::MountResonance { .. } | Effect::ShortedTurn { .. })
         | None => {}
     }
     // With a coupling, the viscous loss acts on the load side.
@@ -702,7 +752,34 @@ fn rhs(
     };
     dx[0] = (u - m.r * i - flux * m.c_m * w) / inductance;
     dx[1] = (flux * m.c_g * i - d_motor * w + torque) / motor_inertia;
+    match e {
+        Some(&Effect::MountResonance { a, f_s, zeta_s }) => {
+            // x[2] the stator's twist, x[3] its speed; the winding sees the relative speed.
+            let relative = w - x[3];
+            let (k_s, c_s) = mount_spring(a, f_s, zeta_s);
+            let winding = m.c_g * i - m.d * relative;
+            dx[0] = (u - m.r * i - m.c_m * relative) / inductance;
+            dx[1] = winding / m.j;
+            dx[2] = x[3];
+            dx[3] = (-winding - k_s * x[2] - c_s * x[3]) * a / m.j;
+        }
+        Some(&Effect::ShortedTurn { k, tau_s }) => {
+            // [L, M; M, L]·d(I, I_s)/dt = (v, −R_s·I_s), M = k·L, R_s = L/τ_s.
+            let v = u - m.r * i - m.c_m * w;
+            let (mutual, r_s) = (k * m.l, m.l / tau_s);
+            let det = m.l * m.l * (1.0 - k * k);
+            dx[0] = (m.l * v + mutual * r_s * x[2]) / det;
+            dx[2] = (-m.l * r_s * x[2] - mutual * v) / det;
+        }
+        _ => {}
+    }
     dx
+}
+
+/// The mount's spring and damper for a stator of inertia J/a at natural frequency f_s.
+fn mount_spring(a: f64, f_s: f64, zeta_s: f64) -> (f64, f64) {
+    let (j_s, w_s) = (NOMINAL.j / a, 2.0 * PI * f_s);
+    (j_s * w_s * w_s, 2.0 * zeta_s * j_s * w_s)
 }
 
 fn measured(e: Option<&Effect>, x: &[f64; 4]) -> [f64; 2] {
@@ -717,6 +794,7 @@ fn measured(e: Option<&Effect>, x: &[f64; 4]) -> [f64; 2] {
         Some(&Effect::SpeedQuantization { q }) => [x[0], q * (x[1] / q).round()],
         Some(&Effect::SpeedOffset { b }) => [x[0], x[1] + b],
         Some(&Effect::SpeedCrosstalk { kappa }) => [x[0], x[1] + kappa * x[0]],
+        Some(Effect::MountResonance { .. }) => [x[0], x[1] - x[3]],
         Some(&Effect::TachoRipple { eps, k, phase }) => {
             [x[0], x[1] * (1.0 + eps * (k as f64 * x[2] + phase).sin())]
         }
@@ -731,6 +809,7 @@ fn simulate(m: &Motor, e: Option<&Effect>, input: &Input, times: &[f64]) -> Vec<
     let mut out = Vec::with_capacity(times.len());
     // The speed at every substep, for a reading that arrives late (linear between substeps).
     let mut history: Vec<(f64, f64)> = vec![(0.0, 0.0)];
+    let mut last_read = 0.0;
     for &target in times {
         let h = (target - t) / SUBSTEPS as f64;
         for _ in 0..SUBSTEPS {
@@ -759,6 +838,16 @@ fn simulate(m: &Motor, e: Option<&Effect>, input: &Input, times: &[f64]) -> Vec<
                 a.1 + (b.1 - a.1) * (late - a.0) / (b.0 - a.0)
             };
         }
+        if let Some(&Effect::SpeedWindow { t_w }) = e {
+            y[1] = window_mean(&history, t - t_w, t);
+        }
+        if let Some(&Effect::SensorDropout { d, t_d }) = e {
+            if t >= t_d && t < t_d + d {
+                y[1] = last_read;
+            } else {
+                last_read = y[1];
+            }
+        }
         if let Some(&Effect::EncoderGlitch { a, salt }) = e
             && let Some(sign) = glitch(salt, out.len())
         {
@@ -780,6 +869,22 @@ fn simulate(m: &Motor, e: Option<&Effect>, input: &Input, times: &[f64]) -> Vec<
         out.push(y);
     }
     out
+}
+
+/// The mean of the speed over [from, to] from its substep history (trapezoids, linear between
+/// substeps; at rest before the start).
+fn window_mean(history: &[(f64, f64)], from: f64, to: f64) -> f64 {
+    let mut area = 0.0;
+    for w in history.windows(2) {
+        let ((t0, y0), (t1, y1)) = (w[0], w[1]);
+        if t1 <= from || t0 >= to {
+            continue;
+        }
+        let (a, b) = (t0.max(from), t1.min(to));
+        let at = |t: f64| y0 + (y1 - y0) * (t - t0) / (t1 - t0);
+        area += 0.5 * (at(a) + at(b)) * (b - a);
+    }
+    area / (to - from)
 }
 
 /// A recording's CSV text: `t,I,omega` and the held voltage `U` where there is one.
@@ -915,6 +1020,18 @@ fn expected(e: &Effect, input_level: f64) -> String {
         Effect::HydraulicLoad { .. } => r#"{"kind": "unknown"}"#.into(),
         // Isolated miscounts follow nothing: something is left on ω that nothing names.
         Effect::EncoderGlitch { .. } => r#"{"kind": "unknown", "channel": "omega"}"#.into(),
+        // The stator's mode rings in the relative speed the encoder reads, after every step.
+        Effect::MountResonance { a, f_s, zeta_s } => {
+            let (fr, zr) = mount_ringing(a, f_s, zeta_s);
+            format!(r#"{{"kind": "oscillation", "frequency_hz": {fr}, "damping_ratio": {zr}, "channel": "omega", "ringing": true}}"#)
+        }
+        // A moving average over T_w lags the speed by T_w/2 to first order.
+        Effect::SpeedWindow { t_w } => format!(r#"{{"kind": "lag", "channel": "omega", "seconds": {}}}"#, t_w / 2.0),
+        // A held reading follows nothing of the motor: something is left on ω.
+        Effect::SensorDropout { .. } => r#"{"kind": "unknown", "channel": "omega"}"#.into(),
+        // The loop's current is a hidden state of the voltage balance, no function of the
+        // state: something is left that no dictionary names.
+        Effect::ShortedTurn { .. } => r#"{"kind": "unknown"}"#.into(),
         // The flux's ripple in both balances (as flux_saturation's): the kind, the angle and
         // the order are asked.
         Effect::CommutatorRipple { k, .. } => format!(r#"{{"kind": "state", "functions": ["omega*sin(k*theta)", "omega*cos(k*theta)", "I*sin(k*theta)", "I*cos(k*theta)"], "k": {k}}}"#),
@@ -944,6 +1061,28 @@ fn dc_link_ringing(z: f64, f: f64, zeta: f64, duty: f64) -> (f64, f64) {
         -duty / c, 0.0, 1.0 / c, 0.0,
     );
     let pair = a
+        .complex_eigenvalues()
+        .iter()
+        .copied()
+        .max_by(|p, q| p.im.abs().total_cmp(&q.im.abs()))
+        .unwrap();
+    (pair.im.abs() / (2.0 * PI), -pair.re / pair.norm())
+}
+
+/// The stator mode's damped frequency (Hz) and damping ratio with the nominal motor on its
+/// mount: the most oscillatory pair of the linearized (I, ω, twist, stator speed).
+fn mount_ringing(a: f64, f_s: f64, zeta_s: f64) -> (f64, f64) {
+    let m = NOMINAL;
+    let (k_s, c_s) = mount_spring(a, f_s, zeta_s);
+    let j_s = m.j / a;
+    #[rustfmt::skip]
+    let mat = nalgebra::Matrix4::new(
+        -m.r / m.l, -m.c_m / m.l, 0.0, m.c_m / m.l,
+        m.c_g / m.j, -m.d / m.j, 0.0, m.d / m.j,
+        0.0, 0.0, 0.0, 1.0,
+        -m.c_g / j_s, m.d / j_s, -k_s / j_s, -(c_s + m.d) / j_s,
+    );
+    let pair = mat
         .complex_eigenvalues()
         .iter()
         .copied()
