@@ -421,3 +421,30 @@ fn an_encoder_s_isolated_miscounts_are_named_where_they_are_not_read_as_a_ringin
     }
     assert!(u.suggestion.contains("isolated"), "{}", u.suggestion);
 }
+
+/// A shorted turn (`beyond_library_cases`, shorted_turn-810016: a secondary loop coupled to the
+/// winding by k = 0.38, τ_s = 18 ms) leaves a relaxation of the current after each step that
+/// no term holds. The ringing alternative, damped to ζ 0.50, stood in for it (session 21's
+/// build reported an oscillation of I at 124.7 Hz that rings); a ringing claims its frequency
+/// only where it beats a transient that does not ring, and here it does not: the verdict is
+/// `unknown`, its sentence the transient's, and no ringing of I is offered beside it.
+#[test]
+fn a_shorted_turn_s_relaxation_after_each_step_is_not_read_as_a_ringing() {
+    let (problem, _) = fixture("shorted_turn-810016");
+    let d = whole_library(&problem);
+    let u = d
+        .unexplained
+        .expect("a 128-nat miss no term holds is not nothing missing");
+    assert!(
+        matches!(u.fingerprint, Fingerprint::Unknown { .. }),
+        "{:?}",
+        u.fingerprint
+    );
+    assert!(u.suggestion.contains("no ringing"), "{}", u.suggestion);
+    for f in u.considered.iter().chain(&u.alternatives) {
+        assert!(
+            !matches!(f, Fingerprint::Oscillation { ringing: true, channel, .. } if channel == "I"),
+            "{f:?}"
+        );
+    }
+}

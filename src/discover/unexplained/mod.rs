@@ -4,7 +4,9 @@
 //! are asked whether generic alternatives that can hold "anything" explain them better than
 //! white noise: a discrepancy polynomial in time per channel (degrees up to a tenth of the
 //! samples), an autoregression of the residual (p = 1, 2, 4, 8), a sinusoid through the record
-//! and a damped sinusoid ringing after each input step (`oscillation`), every channel late by
+//! and a damped sinusoid ringing after each input step (`oscillation`; offered only where it
+//! beats a transient after each step that does not ring, itself generic: `transient`), every
+//! channel late by
 //! τ (an input delay), one channel filtered with time constant τ (a sensor lag) and with a
 //! second-order filter that rings (a resonant sensor, `resonance`), a channel that runs ahead
 //! of the model (its derivative with a lead's sign: generic, no sensor leads, but a balance
@@ -33,6 +35,7 @@
 mod as_given;
 mod figure;
 mod fingerprint;
+mod generic;
 mod order;
 mod oscillation;
 mod outliers;
@@ -46,6 +49,7 @@ mod state;
 mod step_screen;
 mod timing;
 mod torque_response;
+mod transient;
 
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
@@ -60,6 +64,7 @@ use super::settings::EVIDENCE_THRESHOLD;
 pub use as_given::AsGiven;
 pub use figure::{FOLDED_BINS, Folded, UnexplainedFigure};
 pub use fingerprint::{EquationTerm, Fingerprint, LawFunction, equation_with, with_shapes};
+use generic::{Generic, GenericKind};
 pub use oscillation::{frequency_search_cost, lowest_frequency_over};
 use regression::{Explained, Projector, explain};
 pub use spans::Span;
@@ -257,26 +262,6 @@ impl Context {
     }
 }
 
-/// A generic alternative's result on a channel.
-#[derive(Clone)]
-struct Generic {
-    channel: usize,
-    kind: GenericKind,
-    scored: Scored,
-}
-
-/// What a generic alternative is: it can hold "anything" of its shape.
-#[derive(Clone, PartialEq)]
-enum GenericKind {
-    /// A Legendre polynomial in time (the report's `where` is read off the best one).
-    Polynomial,
-    Autoregression,
-    /// The channel's derivative with a lead's sign: the channel runs ahead of the model.
-    Lead,
-    /// Isolated samples far off, following nothing (`outliers`): the samples flagged.
-    Outliers(Vec<usize>),
-}
-
 /// The verdict's report: `null` in the JSON when nothing is left.
 #[derive(Clone, Debug, Serialize)]
 pub struct Unexplained {
@@ -358,11 +343,29 @@ fn scores(ctx: &Context, shift: f64) -> Scores {
                 scored: ctx.score(&ctx.in_channel(c, &lags), 0.0),
             });
         }
-        for o in oscillation::search(ctx, c) {
+        // A ringing claims a frequency only where it beats a transient that does not ring.
+        let transient = transient::search(ctx, c);
+        let rings_not = |o: &oscillation::Oscillation| {
+            o.ringing()
+                && transient
+                    .as_ref()
+                    .is_some_and(|t| t.scored.score >= o.scored.score)
+        };
+        for o in oscillation::search(ctx, c)
+            .into_iter()
+            .filter(|o| !rings_not(o))
+        {
             fingerprints.push(Evidence {
                 fingerprint: o.fingerprint(&name, shift),
                 residual: ctx.y.as_slice().to_vec(),
                 explained: o.scored.explained.fitted.as_slice().to_vec(),
+            });
+        }
+        if let Some(t) = transient {
+            generic.push(Generic {
+                channel: c,
+                kind: GenericKind::Transient(t.taus),
+                scored: t.scored,
             });
         }
         fingerprints.extend(quantized::evidence(ctx, c, shift));
@@ -568,19 +571,12 @@ pub fn unexplained(
     }
     let mut suggestion = fingerprint.suggestion(&channels);
     if let (Fingerprint::Unknown { .. }, Some(g)) = (&fingerprint, best_generic)
-        && let GenericKind::Outliers(samples) = &g.kind
+        && let Some((spans, sentence)) = g.reported(&ctx)
     {
-        (where_, suggestion) = outliers::reported(&ctx, g.channel, samples);
-    } else if let (Fingerprint::Unknown { .. }, Some(g)) = (&fingerprint, best_generic)
-        && g.kind == GenericKind::Lead
-    {
-        suggestion = format!(
-            "{} runs ahead of the model where it changes fast, as if that balance's fast \
-             dynamics were quicker than the model's (in the voltage balance: an inductance \
-             smaller than L, or one that falls with the current); steps of several sizes would \
-             tell a constant from a current-dependent one",
-            ctx.channels[g.channel]
-        );
+        suggestion = sentence;
+        if let Some(spans) = spans {
+            where_ = spans;
+        }
     }
     Ok(Some(Unexplained {
         evidence,
