@@ -96,29 +96,38 @@ fn a_term_the_later_terms_make_redundant_is_dropped() {
     );
 }
 
-/// A coupling fitted with its resonance below what the record can show is not ranked. On this
+/// A coupling fitted with its resonance outside what the record can show is not ranked. On this
 /// record of a voltage drop with a load step (`motorcal simulate --effect
 /// voltage_drop,load_step --conceal --seed 991005`, papers/diagnose-speed's set) the coupling's
-/// fit put f_r at 1.7 Hz — under two periods over the 0.5-s record, a slow torque rather than a
-/// resonance — and led the ranking by 37 nats; now it is left out with a note saying why, and
-/// the selection is the truth.
+/// fit once put f_r at 1.7 Hz — under two periods over the 0.5-s record, a slow torque rather
+/// than a resonance — and led the ranking by 37 nats; it was then left out with a note saying
+/// why. Since a ringing must beat a transient that does not ring (session 22), the model as
+/// given's slow "ringing" no longer starts the coupling there, and its fit resonates inside
+/// the band, far down the ranking. Either way the rule holds: a coupling ranked resonates
+/// between two periods over the record (4.0 Hz) and the Nyquist frequency (500 Hz), one not
+/// ranked is named in a note, and the selection is the truth.
 #[test]
 fn a_coupling_whose_resonance_the_record_cannot_show_is_not_ranked() {
     let diagnosis = rank_only(&case_dir("voltage_drop+load_step"));
-    assert!(
-        diagnosis
-            .ranking
-            .iter()
-            .all(|r| r.effect != "compliant_coupling")
-    );
-    assert!(
-        diagnosis
-            .notes
-            .iter()
-            .any(|n| n.starts_with("compliant_coupling was not ranked")),
-        "notes {:?}",
-        diagnosis.notes
-    );
+    let ranked: Vec<f64> = diagnosis
+        .ranking
+        .iter()
+        .filter(|r| r.effect == "compliant_coupling")
+        .map(|r| r.params["f_r"].expect("a fitted f_r"))
+        .collect();
+    for f_r in &ranked {
+        assert!((4.0..=500.0).contains(f_r), "f_r {f_r}");
+    }
+    if ranked.is_empty() {
+        assert!(
+            diagnosis
+                .notes
+                .iter()
+                .any(|n| n.starts_with("compliant_coupling was not ranked")),
+            "notes {:?}",
+            diagnosis.notes
+        );
+    }
     assert_eq!(selected_sorted(&diagnosis), ["load_step", "voltage_drop"]);
 }
 
