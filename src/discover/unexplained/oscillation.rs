@@ -140,7 +140,13 @@ fn quick_gain(ctx: &Context, c: usize, f: f64, decay: Option<f64>) -> f64 {
 
 /// [`gain`] of y on [`channel_columns`], summed over each column's nonzero window only.
 fn windowed_gain(times: &[f64], steps: &[f64], y: &[f64], f: f64, decay: Option<f64>) -> f64 {
-    let windows = windows(times, steps, f, decay);
+    pair_windows_gain(&windows(times, steps, f, decay), y)
+}
+
+/// [`gain`] of y on column pairs given where they are nonzero (each pair's first row and its
+/// values from there), the normal equations summed over the windows' overlaps only: the
+/// ringing's pairs here, a transient's (`transient`) too.
+pub(super) fn pair_windows_gain(windows: &[(usize, Vec<(f64, f64)>)], y: &[f64]) -> f64 {
     let k = 2 * windows.len();
     let mut h = DVector::zeros(k);
     let mut g = DMatrix::zeros(k, k);

@@ -13,9 +13,10 @@
 //! relaxing after each step, which no term names), and it leads only as a generic one does, by
 //! beating every specific fingerprint by the threshold.
 
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DMatrix;
 
-use super::regression::{explain, gain, golden_max};
+use super::oscillation::pair_windows_gain;
+use super::regression::{explain, golden_max};
 use super::{Context, Scored};
 
 /// The time constants tried, in sample intervals: from half an interval (a transient within one
@@ -34,20 +35,38 @@ pub struct Transient {
 /// Channel c's columns over the record's samples: after each step, e^(−τ/τ₁) and e^(−τ/τ₂),
 /// zero before the step and once below 10⁻⁴.
 fn channel_columns(times: &[f64], steps: &[f64], taus: [f64; 2]) -> DMatrix<f64> {
-    let mut b = DMatrix::zeros(times.len(), 2 * steps.len());
-    for (k, &ts) in steps.iter().enumerate() {
-        let start = times.partition_point(|&t| t < ts);
-        for (q, &tau) in taus.iter().enumerate() {
-            for (i, &t) in times.iter().enumerate().skip(start) {
-                let v = (-(t - ts) / tau).exp();
-                if v < 1e-4 {
-                    break;
-                }
-                b[(i, 2 * k + q)] = v;
-            }
+    let windows = windows(times, steps, taus);
+    let mut b = DMatrix::zeros(times.len(), 2 * windows.len());
+    for (k, (start, values)) in windows.iter().enumerate() {
+        for (i, &(fast, slow)) in values.iter().enumerate() {
+            b[(start + i, 2 * k)] = fast;
+            b[(start + i, 2 * k + 1)] = slow;
         }
     }
     b
+}
+
+/// [`channel_columns`]' pairs where they are nonzero, as `oscillation`'s ringing gives its own:
+/// each step's first row and the pair's values from there, until both are below 10⁻⁴.
+fn windows(times: &[f64], steps: &[f64], taus: [f64; 2]) -> Vec<(usize, Vec<(f64, f64)>)> {
+    let cut = |v: f64| if v < 1e-4 { 0.0 } else { v };
+    steps
+        .iter()
+        .map(|&ts| {
+            let start = times.partition_point(|&t| t < ts);
+            let values = times[start..]
+                .iter()
+                .map(|&t| {
+                    (
+                        cut((-(t - ts) / taus[0]).exp()),
+                        cut((-(t - ts) / taus[1]).exp()),
+                    )
+                })
+                .take_while(|&(a, b)| a > 0.0 || b > 0.0)
+                .collect();
+            (start, values)
+        })
+        .collect()
 }
 
 /// The best transient in channel c, searched over pairs of [`TAU_INTERVALS`] and refined; none
@@ -58,8 +77,10 @@ pub fn search(ctx: &Context, c: usize) -> Option<Transient> {
         return None;
     }
     let interval = (ctx.times[n - 1] - ctx.times[0]) / (n - 1) as f64;
-    let y = DVector::from_column_slice(&ctx.y_perp.as_slice()[c * n..(c + 1) * n]);
-    let quick = |taus: [f64; 2]| gain(&y, &channel_columns(&ctx.times, &ctx.steps, taus));
+    // The search's quick gain, as the ringing's: the projected residual on the unprojected
+    // columns, summed where they are nonzero (the exact score is computed once, at the end).
+    let y = &ctx.y_perp.as_slice()[c * n..(c + 1) * n];
+    let quick = |taus: [f64; 2]| pair_windows_gain(&windows(&ctx.times, &ctx.steps, taus), y);
     let grid: Vec<f64> = TAU_INTERVALS.iter().map(|k| k * interval).collect();
     let pairs: Vec<[f64; 2]> = (0..grid.len())
         .flat_map(|a| ((a + 1)..grid.len()).map(move |b| (a, b)))
@@ -115,5 +136,28 @@ mod tests {
         // The fast one is cut once below 10⁻⁴ (τ = 2 ms: after 18.4 ms).
         assert_eq!(b[(20, 0)], 0.0);
         assert!(b[(18, 0)] > 0.0);
+    }
+
+    #[test]
+    fn the_windowed_gain_is_the_dense_regressions() {
+        use super::super::regression::gain;
+        use nalgebra::DVector;
+        let times: Vec<f64> = (0..600).map(|i| i as f64 * 1e-3).collect();
+        let steps = [0.0, 0.2, 0.23, 0.45];
+        let y: Vec<f64> = times
+            .iter()
+            .map(|t| (-t / 4e-3).exp() + 0.3 * (17.0 * t).sin())
+            .collect();
+        for taus in [[5e-4, 2e-3], [2e-3, 3e-2], [1e-2, 0.2]] {
+            let dense = gain(
+                &DVector::from_column_slice(&y),
+                &channel_columns(&times, &steps, taus),
+            );
+            let windowed = pair_windows_gain(&windows(&times, &steps, taus), &y);
+            assert!(
+                (dense - windowed).abs() <= 1e-9 * dense.abs().max(1.0),
+                "{taus:?}: dense {dense} windowed {windowed}"
+            );
+        }
     }
 }
