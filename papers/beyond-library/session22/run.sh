@@ -62,3 +62,11 @@ $BIN_new simulate --effect none --seed 1800045 --input reversal --out $S/null45
 for V in base new; do eval BIN=\$BIN_$V
   $BIN diagnose --quiet --rank-only --data $S/null45/recording.csv --model $S/null45/motor.toml --json $S/null45/$V.json
 done
+# 6. The review's refactor (1af2868: the transient's quick gain on the ringing's windowed
+#    normal equations): the ninth set again, BIN_win a build of 1af2868, against BIN_new's.
+R=$S/w81; mkdir -p $R
+for C in $S/h81/*/; do N=$(basename $C)
+  $BIN_win diagnose --quiet --data $C/recording.csv --model $C/motor.toml --json $R/$N.json --out $R/$N.d > $R/$N.log 2>&1
+done
+python3 $B/session12/compare_full.py $S/n81 $R > $HERE/compare-full-810000-33d63e9-1af2868.txt
+python3 $HERE/verdict_keys.py $S/n81 $R > $HERE/verdict-keys-810000-33d63e9-1af2868.txt
