@@ -24,7 +24,8 @@
 //! `rotor_rub`; a seventh, `slew_limit`, `clutch_engagement`, `pwm_alias`, `speed_crosstalk`,
 //! `dc_link_resonance`; an eighth, `pump_threshold`, `hydraulic_load`, `encoder_glitch`,
 //! `commutator_ripple` (the last on slow records, `--volts 2`); a ninth, `mount_resonance`,
-//! `speed_window`, `sensor_dropout`, `shorted_turn`.
+//! `speed_window`, `sensor_dropout`, `shorted_turn`; a tenth, `magnet_pickup` (on slow
+//! records, `--volts 2`), `emi_bursts`, `supply_dips`, `seal_friction`, `sensor_hysteresis`.
 //!
 //! cargo run --release --example beyond_library_cases -- [--out DIR] [--per-effect 3]
 //!     [--seed-base 510000] [--min-nats 20] [--max-nats 300] [--effects a,b,…] [--volts 24]
@@ -217,6 +218,25 @@ enum Effect {
     /// time constant τ_s, coupled to the winding by k = M/L, its current a hidden state that
     /// opposes the winding's changes. `--effects shorted_turn`.
     ShortedTurn { k: f64, tau_s: f64 },
+    /// The current sensor (a Hall cell beside the rotor) picking up the magnet's field once
+    /// per revolution: what is read of I is I + a·sin(θ + φ) (on slow records, `--volts 2`).
+    /// `--effects magnet_pickup`.
+    MagnetPickup { a: f64, phase: f64 },
+    /// Interference bursts on the current's reading (a contactor's or a welder's EMI): every
+    /// P samples (P 20–60, from the draw), two samples read a off, the sign by a hash.
+    /// `--effects emi_bursts`.
+    EmiBursts { a: f64, period: usize, salt: u64 },
+    /// A supply shared with a load that switches on periodically: the drive's voltage dips by
+    /// a share d for 30% of each period 1/f (f 10–40 Hz), whatever the motor does.
+    /// `--effects supply_dips`.
+    SupplyDips { d: f64, f: f64, phase: f64 },
+    /// A lip seal's drag, growing with the root of the speed: −a·√|ω|·tanh(ω).
+    /// `--effects seal_friction`.
+    SealFriction { a: f64 },
+    /// The current sensor's magnetic hysteresis: what is read of I moves only once I has moved
+    /// h beyond it (a play operator of half-width h, starting at zero).
+    /// `--effects sensor_hysteresis`.
+    SensorHysteresis { h: f64 },
 }
 
 /// Whether sample `k` is one the encoder miscounts, and the sign: splitmix64 of salt and k.
@@ -227,6 +247,18 @@ fn glitch(salt: u64, k: usize) -> Option<f64> {
     z ^= z >> 31;
     z.is_multiple_of(100)
         .then(|| if (z >> 40) & 1 == 1 { 1.0 } else { -1.0 })
+}
+
+/// The sign of the EMI burst `n`: a bit of splitmix64 of salt and n.
+fn burst_sign(salt: u64, n: usize) -> f64 {
+    let mut z = salt.wrapping_add((n as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15));
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    if (z ^ (z >> 31)) >> 63 == 1 {
+        1.0
+    } else {
+        -1.0
+    }
 }
 
 impl Effect {
@@ -386,6 +418,22 @@ impl Effect {
                 k: 0.1,
                 tau_s: rng.random_range(2e-3..20e-3),
             },
+            "magnet_pickup" => Effect::MagnetPickup {
+                a: 1.0,
+                phase: rng.random_range(0.0..2.0 * PI),
+            },
+            "emi_bursts" => Effect::EmiBursts {
+                a: 10.0,
+                period: rng.random_range(20..=60usize),
+                salt: rng.random(),
+            },
+            "supply_dips" => Effect::SupplyDips {
+                d: 0.01,
+                f: rng.random_range(10.0..40.0),
+                phase: rng.random_range(0.0..1.0),
+            },
+            "seal_friction" => Effect::SealFriction { a: 1e-5 },
+            "sensor_hysteresis" => Effect::SensorHysteresis { h: 1.0 },
             other => panic!("unknown effect {other}; known: {:?}", Effect::NAMES),
         }
     }
@@ -438,6 +486,10 @@ impl Effect {
             Effect::SpeedWindow { t_w } => t_w,
             Effect::SensorDropout { d, .. } => d,
             Effect::ShortedTurn { k, .. } => k,
+            Effect::MagnetPickup { a, .. } | Effect::EmiBursts { a, .. } => a,
+            Effect::SupplyDips { d, .. } => d,
+            Effect::SealFriction { a } => a,
+            Effect::SensorHysteresis { h } => h,
         }
     }
 
@@ -488,6 +540,10 @@ impl Effect {
             Effect::SpeedWindow { t_w } => *t_w = s,
             Effect::SensorDropout { d, .. } => *d = s,
             Effect::ShortedTurn { k, .. } => *k = s,
+            Effect::MagnetPickup { a, .. } | Effect::EmiBursts { a, .. } => *a = s,
+            Effect::SupplyDips { d, .. } => *d = s,
+            Effect::SealFriction { a } => *a = s,
+            Effect::SensorHysteresis { h } => *h = s,
         }
         e
     }
@@ -537,6 +593,12 @@ impl Effect {
             Effect::SpeedWindow { .. } => 0.02,
             Effect::SensorDropout { .. } => 0.1,
             Effect::ShortedTurn { .. } => 0.9,
+            // A pickup or a burst of at most 50 and 500 A; a dip of at most half the supply;
+            // a play of at most 50 A.
+            Effect::MagnetPickup { .. } => 50.0,
+            Effect::EmiBursts { .. } => 500.0,
+            Effect::SupplyDips { .. } => 0.5,
+            Effect::SensorHysteresis { .. } => 50.0,
             _ => 1.0,
         }
     }
@@ -720,8 +782,14 @@ fn rhs(
             flux = 1.0 + eps * (k as f64 * x[2] + phase).sin();
             dx[2] = w;
         }
-        // The angle, which the tacho's ripple reads.
-        Some(Effect::TachoRipple { .. }) => dx[2] = w,
+        // The angle, which the tacho's ripple and the Hall cell's pickup read.
+        Some(Effect::TachoRipple { .. } | Effect::MagnetPickup { .. }) => dx[2] = w,
+        Some(&Effect::SupplyDips { d, f, phase }) => {
+            if t >= 0.0 && (f * t + phase).fract() < 0.3 {
+                u *= 1.0 - d;
+            }
+        }
+        Some(&Effect::SealFriction { a }) => torque -= a * w.abs().sqrt() * w.tanh(),
         // These act on what is measured (`measured`, `simulate`), not on the motor.
         Some(
             Effect::LeakageCurrent { .. }
@@ -735,7 +803,9 @@ fn rhs(
             | Effect::SpeedCrosstalk { .. }
             | Effect::EncoderGlitch { .. }
             | Effect::SpeedWindow { .. }
-            | Effect::SensorDropout { .. },
+            | Effect::SensorDropout { .. }
+            | Effect::EmiBursts { .. }
+            | Effect::SensorHysteresis { .. },
         )
         // Their balances are rewritten below.
         | Some(Effect::MountResonance { .. } | Effect::ShortedTurn { .. })
@@ -798,6 +868,7 @@ fn measured(e: Option<&Effect>, x: &[f64; 4]) -> [f64; 2] {
         Some(&Effect::TachoRipple { eps, k, phase }) => {
             [x[0], x[1] * (1.0 + eps * (k as f64 * x[2] + phase).sin())]
         }
+        Some(&Effect::MagnetPickup { a, phase }) => [x[0] + a * (x[2] + phase).sin(), x[1]],
         _ => [x[0], x[1]],
     }
 }
@@ -852,6 +923,18 @@ fn simulate(m: &Motor, e: Option<&Effect>, input: &Input, times: &[f64]) -> Vec<
             && let Some(sign) = glitch(salt, out.len())
         {
             y[1] += sign * a;
+        }
+        if let Some(&Effect::EmiBursts { a, period, salt }) = e {
+            // The burst's first sample at an offset of the period the salt picks; its sign
+            // from the burst's index.
+            let k = out.len() + period - (salt as usize % period);
+            if k % period < 2 {
+                y[0] += burst_sign(salt, k / period) * a;
+            }
+        }
+        if let Some(&Effect::SensorHysteresis { h }) = e {
+            last_read = last_read.clamp(y[0] - h, y[0] + h);
+            y[0] = last_read;
         }
         if let Some(&Effect::LeakageCurrent { g }) = e {
             y[0] += g * input.at(t, times);
@@ -1032,6 +1115,17 @@ fn expected(e: &Effect, input_level: f64) -> String {
         // The loop's current is a hidden state of the voltage balance, no function of the
         // state: something is left that no dictionary names.
         Effect::ShortedTurn { .. } => r#"{"kind": "unknown"}"#.into(),
+        // What is read of I, in the angle, once per revolution.
+        Effect::MagnetPickup { .. } => r#"{"kind": "state", "balance": "measurement:I", "functions": ["sin(k*theta)", "cos(k*theta)"], "k": 1}"#.into(),
+        // Bursts at a period of samples follow nothing of the motor: something is left on I.
+        Effect::EmiBursts { .. } => r#"{"kind": "unknown", "channel": "I"}"#.into(),
+        // The supply's dips run on whatever the motor does, at their repetition rate.
+        Effect::SupplyDips { f, .. } => format!(r#"{{"kind": "oscillation", "frequency_hz": {f}, "channel": "I", "ringing": false}}"#),
+        // √|ω| is in no dictionary: a state of the torque balance, in the speed.
+        Effect::SealFriction { .. } => r#"{"kind": "state", "balance": "torque", "functions": ["sign(omega)", "omega"]}"#.into(),
+        // A play operator's output is the current's history, no function of the state: something
+        // is left on I that no dictionary names.
+        Effect::SensorHysteresis { .. } => r#"{"kind": "unknown", "channel": "I"}"#.into(),
         // The flux's ripple in both balances (as flux_saturation's): the kind, the angle and
         // the order are asked.
         Effect::CommutatorRipple { k, .. } => format!(r#"{{"kind": "state", "functions": ["omega*sin(k*theta)", "omega*cos(k*theta)", "I*sin(k*theta)", "I*cos(k*theta)"], "k": {k}}}"#),
