@@ -23,6 +23,13 @@ pub(super) enum GenericKind {
     Outliers(Vec<usize>),
     /// A transient after each step that does not ring (`transient`): its time constants [s].
     Transient([f64; 2]),
+    /// A noise of two scales (`outliers`, where the fit is not isolated outliers): the samples
+    /// in the wide part, its share and its width over the core's.
+    Tails {
+        samples: Vec<usize>,
+        share: f64,
+        width: f64,
+    },
 }
 
 impl Generic {
@@ -33,6 +40,15 @@ impl Generic {
         match &self.kind {
             GenericKind::Outliers(samples) => {
                 let (spans, sentence) = outliers::reported(ctx, self.channel, samples);
+                Some((Some(spans), sentence))
+            }
+            GenericKind::Tails {
+                samples,
+                share,
+                width,
+            } => {
+                let (spans, sentence) =
+                    outliers::tails_reported(ctx, self.channel, samples, *share, *width);
                 Some((Some(spans), sentence))
             }
             GenericKind::Lead => Some((

@@ -372,7 +372,7 @@ fn scores(ctx: &Context, shift: f64) -> Scores {
         if let Some(o) = outliers::evidence(ctx, c) {
             generic.push(Generic {
                 channel: c,
-                kind: GenericKind::Outliers(o.samples),
+                kind: o.kind,
                 scored: o.scored,
             });
         }
