@@ -122,7 +122,7 @@ fn contaminated_normal(y: &[f64]) -> Option<Mixture> {
         a = moment(&|ri| 1.0 - ri);
         b = moment(&|ri| ri).max(MIN_WIDTH * a);
     }
-    ln_l.is_finite().then(|| Mixture {
+    ln_l.is_finite().then_some(Mixture {
         gain: ln_l - single,
         r,
         share: eps,
