@@ -4,7 +4,7 @@
 //! 560012 of `--effects flux_saturation,thermal_magnet,current_limit,supply_ripple --per-effect
 //! 3 --seed-base 560000`, as is current_limit-560011; a return spring, a leaking and a clipping
 //! current sensor, a speed sensor's offset, mains pickup on the current's and a tachometer's
-//! ripple, named at their tests; the answer beside each recording), leave a state fingerprint
+//! ripple, a Hall cell's pickup of the magnet, named at their tests; the answer beside each recording), leave a state fingerprint
 //! or a forced oscillation; the law term written from it is fitted, taken by the ranking's
 //! threshold, and holds the true functions with coefficients near the truth, leaving nothing.
 //! Null records of the crate's own generator, with every candidate allowed, discover nothing.
@@ -399,6 +399,23 @@ fn a_tachogenerator_s_ripple_is_discovered_in_what_is_read_of_the_speed() {
     );
     assert_eq!(law.k, Some(truth_value(&answer, "k")));
     assert_intervals_hold(&law, &[eps * phase.cos(), eps * phase.sin()]);
+    assert!(d.unexplained.is_none(), "{:?}", d.unexplained);
+}
+
+/// A Hall cell beside the rotor that reads the magnet's field once per revolution: I read as
+/// I + a·sin(θ + φ) (magnet_pickup-825001 of `--effects magnet_pickup --per-effect 4
+/// --seed-base 825000 --volts 2`, a slow constant-input record). Before the angle's ripple was
+/// offered in what is read of I, a law in sin(θ), cos(θ) of the voltage or the torque balance
+/// took it: the right order, the wrong place. The law in what is read of I, at k = 1, each 95%
+/// interval holding a·cos φ and a·sin φ, nothing left.
+#[test]
+fn a_hall_cell_s_pickup_of_the_magnet_is_discovered_in_what_is_read_of_the_current() {
+    let (problem, answer) = fixture("magnet_pickup-825001");
+    let (a, phase) = (truth_value(&answer, "a"), truth_value(&answer, "phase"));
+    let d = diagnose(&problem);
+    let law = discovered_in(&d, "measurement:I", &["sin(k*theta)", "cos(k*theta)"]);
+    assert_eq!(law.k, Some(1.0));
+    assert_intervals_hold(&law, &[a * phase.cos(), a * phase.sin()]);
     assert!(d.unexplained.is_none(), "{:?}", d.unexplained);
 }
 

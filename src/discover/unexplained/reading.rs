@@ -6,7 +6,7 @@ use nalgebra::DMatrix;
 
 use crate::motor::Term;
 use crate::motor::dictionary::{
-    self, CONSTANT, CURRENT_LIMIT, N_FUNCTIONS, Point, READING_RIPPLE, Shapes,
+    self, CONSTANT, CURRENT_LIMIT, N_FUNCTIONS, Point, READING_RIPPLE, RIPPLES, Shapes,
 };
 
 use super::super::candidate::Candidate;
@@ -30,7 +30,14 @@ use super::{Context, Evidence};
 /// balances' selection reasons, about 5·P(χ²₁ > 14.2) ≈ 0.1% per channel on a null record (on
 /// I, with the current limit's six, ln 10: 7.8 nats). The speed's ripple adds two columns and
 /// one pair per harmonic sampled: at 24 V (k = 1 only) ln 8, 0.47 nats more on ω; on a slow
-/// record sampling all seven, ln 26, 1.65 nats more.
+/// record sampling all seven, ln 26, 1.65 nats more. The current's reading is offered the
+/// angle's own ripple the same way, sin(k·θ) and cos(k·θ) alone: a Hall cell beside the rotor
+/// that reads the magnet's field (or a shunt's pickup of a commutator) adds to I what the angle
+/// decides, not the current. Before it was offered, magnet_pickup-825001 to -825004 (`measured
+/// I += sin(θ + φ)` at 2 V) were named laws of the torque or voltage balance in the angle: the
+/// right order, the wrong place. Its moves (each of the pair alone, and the pair) raise the
+/// price of I's first column by the logarithm of how many more are tried: about half a nat
+/// on the six of session 20's 118 whose score it moved, and no selection or kind there.
 const MEASURED: [usize; 8] = [0, 1, 2, 5, 7, 9, 12, CONSTANT];
 /// The input, offered where it varies.
 const INPUT: usize = 9;
@@ -115,6 +122,11 @@ pub(super) fn fingerprints(
         if Some(c) == speed && READING_RIPPLE.iter().all(|&f| fresh(f)) {
             for &h in harmonics {
                 columns.extend(READING_RIPPLE.map(|f| Column::new(f, Shape::Harmonic(h))));
+            }
+        }
+        if Some(c) == current && RIPPLES[0].iter().all(|&f| fresh(f)) {
+            for &h in harmonics {
+                columns.extend(RIPPLES[0].map(|f| Column::new(f, Shape::Harmonic(h))));
             }
         }
         let shapes: Vec<Shapes> = columns
