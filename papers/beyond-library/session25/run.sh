@@ -46,3 +46,5 @@ $BIN diagnose --quiet --rank-only --data ../shared/data/real/emps/emps_estimatio
 python3 $B/session12/compare_full.py $S/real/new $T/real > $HERE/compare-full-real-session23-session25.txt
 # 4. The new test against 6b701d9's source (the test and its fixture copied there): it fails.
 #    cargo test --release --test law_discovery a_hall_cell   (printed in the section)
+# 5. What a supply's dips left after the selected term can give a searched sinusoid (a bound).
+(cd $HERE && python3 dips_bound.py > dips-bound.txt)
