@@ -25,7 +25,9 @@
 //! `dc_link_resonance`; an eighth, `pump_threshold`, `hydraulic_load`, `encoder_glitch`,
 //! `commutator_ripple` (the last on slow records, `--volts 2`); a ninth, `mount_resonance`,
 //! `speed_window`, `sensor_dropout`, `shorted_turn`; a tenth, `magnet_pickup` (on slow
-//! records, `--volts 2`), `emi_bursts`, `supply_dips`, `seal_friction`, `sensor_hysteresis`.
+//! records, `--volts 2`), `emi_bursts`, `supply_dips`, `seal_friction`, `sensor_hysteresis`;
+//! an eleventh, `sample_jitter`, `asymmetric_tacho`, `encoder_missing_line` (the last on slow
+//! records, `--volts 2`).
 //!
 //! cargo run --release --example beyond_library_cases -- [--out DIR] [--per-effect 3]
 //!     [--seed-base 510000] [--min-nats 20] [--max-nats 300] [--effects a,b,…] [--volts 24]
@@ -237,6 +239,18 @@ enum Effect {
     /// h beyond it (a play operator of half-width h, starting at zero).
     /// `--effects sensor_hysteresis`.
     SensorHysteresis { h: f64 },
+    /// The sampling instants jitter: each sample is taken δ late, δ ~ N(0, s²) drawn per
+    /// sample (a converter's clock shared with a busy processor). What is read is then the
+    /// channel at t + δ, about y + δ·dy/dt: a noise that follows the slope.
+    /// `--effects sample_jitter`.
+    SampleJitter { s: f64, salt: u64 },
+    /// A tachogenerator whose gain differs with the direction: ω read as ω + ε·|ω| (its
+    /// brushes' drop or a diode in its conditioning). `--effects asymmetric_tacho`.
+    AsymmetricTacho { eps: f64 },
+    /// An encoder with a damaged line: the speed from its pulses reads low over a narrow span
+    /// of each revolution, ω·(1 − ε·exp(−(wrap(θ + φ)/0.3)²)) (on slow records, `--volts 2`).
+    /// `--effects encoder_missing_line`.
+    EncoderMissingLine { eps: f64, phase: f64 },
 }
 
 /// Whether sample `k` is one the encoder miscounts, and the sign: splitmix64 of salt and k.
@@ -247,6 +261,19 @@ fn glitch(salt: u64, k: usize) -> Option<f64> {
     z ^= z >> 31;
     z.is_multiple_of(100)
         .then(|| if (z >> 40) & 1 == 1 { 1.0 } else { -1.0 })
+}
+
+/// A standard normal draw for sample `k`: Box–Muller over two splitmix64 uniforms of salt and
+/// k, so that the jitter is a function of the case's draw alone.
+fn jitter_normal(salt: u64, k: usize) -> f64 {
+    let uniform = |j: u64| {
+        let mut z = salt ^ (2 * k as u64 + j + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let (u1, u2) = (uniform(0).max(1e-300), uniform(1));
+    (-2.0 * u1.ln()).sqrt() * (2.0 * PI * u2).cos()
 }
 
 /// The sign of the EMI burst `n`: a bit of splitmix64 of salt and n.
@@ -434,6 +461,15 @@ impl Effect {
             },
             "seal_friction" => Effect::SealFriction { a: 1e-5 },
             "sensor_hysteresis" => Effect::SensorHysteresis { h: 1.0 },
+            "sample_jitter" => Effect::SampleJitter {
+                s: 1e-6,
+                salt: rng.random(),
+            },
+            "asymmetric_tacho" => Effect::AsymmetricTacho { eps: 0.01 },
+            "encoder_missing_line" => Effect::EncoderMissingLine {
+                eps: 0.01,
+                phase: rng.random_range(0.0..2.0 * PI),
+            },
             other => panic!("unknown effect {other}; known: {:?}", Effect::NAMES),
         }
     }
@@ -490,6 +526,8 @@ impl Effect {
             Effect::SupplyDips { d, .. } => d,
             Effect::SealFriction { a } => a,
             Effect::SensorHysteresis { h } => h,
+            Effect::SampleJitter { s, .. } => s,
+            Effect::AsymmetricTacho { eps } | Effect::EncoderMissingLine { eps, .. } => eps,
         }
     }
 
@@ -544,6 +582,8 @@ impl Effect {
             Effect::SupplyDips { d, .. } => *d = s,
             Effect::SealFriction { a } => *a = s,
             Effect::SensorHysteresis { h } => *h = s,
+            Effect::SampleJitter { s: jitter, .. } => *jitter = s,
+            Effect::AsymmetricTacho { eps } | Effect::EncoderMissingLine { eps, .. } => *eps = s,
         }
         e
     }
@@ -599,6 +639,9 @@ impl Effect {
             Effect::EmiBursts { .. } => 500.0,
             Effect::SupplyDips { .. } => 0.5,
             Effect::SensorHysteresis { .. } => 50.0,
+            // A jitter of at most 0.2 ms; a gain's asymmetry or a line's dip of at most half.
+            Effect::SampleJitter { .. } => 2e-4,
+            Effect::AsymmetricTacho { .. } | Effect::EncoderMissingLine { .. } => 0.5,
             _ => 1.0,
         }
     }
@@ -783,7 +826,11 @@ fn rhs(
             dx[2] = w;
         }
         // The angle, which the tacho's ripple and the Hall cell's pickup read.
-        Some(Effect::TachoRipple { .. } | Effect::MagnetPickup { .. }) => dx[2] = w,
+        Some(
+            Effect::TachoRipple { .. }
+            | Effect::MagnetPickup { .. }
+            | Effect::EncoderMissingLine { .. },
+        ) => dx[2] = w,
         Some(&Effect::SupplyDips { d, f, phase }) => {
             if t >= 0.0 && (f * t + phase).fract() < 0.3 {
                 u *= 1.0 - d;
@@ -805,7 +852,9 @@ fn rhs(
             | Effect::SpeedWindow { .. }
             | Effect::SensorDropout { .. }
             | Effect::EmiBursts { .. }
-            | Effect::SensorHysteresis { .. },
+            | Effect::SensorHysteresis { .. }
+            | Effect::SampleJitter { .. }
+            | Effect::AsymmetricTacho { .. },
         )
         // Their balances are rewritten below.
         | Some(Effect::MountResonance { .. } | Effect::ShortedTurn { .. })
@@ -869,6 +918,11 @@ fn measured(e: Option<&Effect>, x: &[f64; 4]) -> [f64; 2] {
             [x[0], x[1] * (1.0 + eps * (k as f64 * x[2] + phase).sin())]
         }
         Some(&Effect::MagnetPickup { a, phase }) => [x[0] + a * (x[2] + phase).sin(), x[1]],
+        Some(&Effect::AsymmetricTacho { eps }) => [x[0], x[1] + eps * x[1].abs()],
+        Some(&Effect::EncoderMissingLine { eps, phase }) => {
+            let wrapped = (x[2] + phase + PI).rem_euclid(2.0 * PI) - PI;
+            [x[0], x[1] * (1.0 - eps * (-(wrapped / 0.3).powi(2)).exp())]
+        }
         _ => [x[0], x[1]],
     }
 }
@@ -931,6 +985,13 @@ fn simulate(m: &Motor, e: Option<&Effect>, input: &Input, times: &[f64]) -> Vec<
             if k % period < 2 {
                 y[0] += burst_sign(salt, k / period) * a;
             }
+        }
+        if let Some(&Effect::SampleJitter { s, salt }) = e {
+            // The channels' slopes at the sample, from the right-hand side itself.
+            let dx = rhs(m, e, input, times, t, &x);
+            let delta = s * jitter_normal(salt, out.len());
+            y[0] += delta * dx[0];
+            y[1] += delta * dx[1];
         }
         if let Some(&Effect::SensorHysteresis { h }) = e {
             last_read = last_read.clamp(y[0] - h, y[0] + h);
@@ -1126,6 +1187,15 @@ fn expected(e: &Effect, input_level: f64) -> String {
         // A play operator's output is the current's history, no function of the state: something
         // is left on I that no dictionary names.
         Effect::SensorHysteresis { .. } => r#"{"kind": "unknown", "channel": "I"}"#.into(),
+        // A noise that follows the slope follows no function of the state: something is left
+        // on I, where the current's slope is steep after each step.
+        Effect::SampleJitter { .. } => r#"{"kind": "unknown", "channel": "I"}"#.into(),
+        // What is read of ω, even in ω: |ω| is in no dictionary, so the functions are not
+        // asked, only the kind and the place.
+        Effect::AsymmetricTacho { .. } => r#"{"kind": "state", "balance": "measurement:omega"}"#.into(),
+        // What is read of ω, in the angle, a narrow dip once per revolution: the kind, the
+        // place and the angle are asked (its harmonics fall off slowly: k is not).
+        Effect::EncoderMissingLine { .. } => r#"{"kind": "state", "balance": "measurement:omega", "functions": ["omega*sin(k*theta)", "omega*cos(k*theta)"]}"#.into(),
         // The flux's ripple in both balances (as flux_saturation's): the kind, the angle and
         // the order are asked.
         Effect::CommutatorRipple { k, .. } => format!(r#"{{"kind": "state", "functions": ["omega*sin(k*theta)", "omega*cos(k*theta)", "I*sin(k*theta)", "I*cos(k*theta)"], "k": {k}}}"#),
