@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Session 25's runs, as they were made, from the root. BIN is a build of this session's source
 # (the angle's ripple offered in what is read of I: src/discover/unexplained/reading.rs),
-# STUDY its diagnose_study; BIN_base and STUDY_base builds of 6b701d9 (14b6786's source). The
+# STUDY its diagnose_study; GEN and LIBRES the examples beyond_library_cases and library_residual
+# of c8dc79c; BIN_base and STUDY_base builds of 6b701d9 (14b6786's source). The
 # cases are those of session23/run.sh: the tenth set in $S/h82 and $S/h82v (its section 1),
 # the 118 in $S/hold (its section 4), whose reports by 14b6786's source are in $S/n118.
 set -e
@@ -48,3 +49,16 @@ python3 $B/session12/compare_full.py $S/real/new $T/real > $HERE/compare-full-re
 #    cargo test --release --test law_discovery a_hall_cell   (printed in the section)
 # 5. What a supply's dips left after the selected term can give a searched sinusoid (a bound).
 (cd $HERE && python3 dips_bound.py > dips-bound.txt)
+# 6. An eleventh set (c8dc79c's generator, GEN), blind, whole commands, one at a time, quiet.
+$GEN --out $T/h83 --effects sample_jitter,asymmetric_tacho --per-effect 4 --seed-base 830000 > $HERE/cases-830000.log
+$GEN --out $T/h83v --effects encoder_missing_line --per-effect 4 --seed-base 835000 --volts 2 > $HERE/cases-835000.log
+mkdir -p $T/all83 $T/n83 $T/tn83; for d in $T/h83/* $T/h83v/*; do ln -sfn $d $T/all83/$(basename $d); done
+for C in $T/all83/*/; do N=$(basename $C)
+  $BIN diagnose --quiet --data $C/recording.csv --model $C/motor.toml --json $T/n83/$N.json --out $T/n83/$N.d > $T/n83/$N.log 2>&1
+  mkdir -p $T/tn83/$N; ln -sf $T/n83/$N.json $T/tn83/$N/report.json
+done
+$LIBRES $T/all83/*/ > $HERE/library-residual-830000.md
+python3 $B/session19/case_table.py $T/all83 $T/n83 > $HERE/case-table-830000-session25.md
+(cd $B && python3 kind_table.py $T/all83:$T/tn83:session25/library-residual-830000.md) > $HERE/kind-table-830000-session25.md
+(cd $B && python3 rule_breaks.py $T/all83:$T/tn83:session25/library-residual-830000.md) > $HERE/rule-breaks-830000-session25.txt
+python3 $B/whole_commands.py $T/n83 $T/all83 > $HERE/whole-command-times-830000-session25.txt
