@@ -16,7 +16,7 @@
 
 mod beyond;
 
-use beyond::{fixture, truth_value};
+use beyond::{fixture, truth_integer, truth_value};
 
 use motorcal::discover::{Diagnosis, DiscoverSettings, Fingerprint, Unexplained, discover};
 use motorcal::study::cases::{CaseOptions, make_case};
@@ -459,17 +459,8 @@ fn a_shorted_turn_s_relaxation_after_each_step_is_not_read_as_a_ringing() {
 #[test]
 fn interference_bursts_on_the_current_are_not_nothing_missing() {
     let (problem, answer) = fixture("emi_bursts-820009");
-    let text = answer["truth"].as_str().unwrap();
-    let field = |name: &str| -> u64 {
-        let at = text.find(name).unwrap() + name.len();
-        text[at..]
-            .split([',', ' ', '}'])
-            .next()
-            .unwrap()
-            .parse()
-            .unwrap()
-    };
-    let (period, salt) = (field("period: ") as usize, field("salt: "));
+    let period = truth_integer(&answer, "period") as usize;
+    let salt = truth_integer(&answer, "salt");
     let times = problem.recordings[0].time.clone();
     let bursts: Vec<usize> = (0..times.len())
         .filter(|&k| (k + period - (salt as usize % period)) % period < 2)

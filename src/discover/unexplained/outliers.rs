@@ -132,9 +132,13 @@ fn contaminated_normal(y: &[f64]) -> Option<Mixture> {
 }
 
 impl Mixture {
-    /// Outliers: the share inside its cap, the wide part wider than the floor.
-    fn interior(&self) -> bool {
-        self.share < MAX_SHARE && self.wide > MIN_WIDTH * self.core
+    /// Isolated outliers: the share inside its cap, the wide part wider than the floor, and no
+    /// two of the `flagged` samples (indices into the record, in order) side by side.
+    fn isolated_outliers(&self, flagged: &[usize]) -> bool {
+        self.share < MAX_SHARE
+            && self.wide > MIN_WIDTH * self.core
+            && !flagged.is_empty()
+            && flagged.windows(2).all(|w| w[1] > w[0] + 1)
     }
 }
 
@@ -157,20 +161,19 @@ pub(super) fn evidence(ctx: &Context, c: usize) -> Option<Outliers> {
         .filter(|(_, ri)| **ri > 0.5)
         .map(|(&i, _)| i)
         .collect();
-    let isolated = !samples.is_empty() && samples.windows(2).all(|w| w[1] > w[0] + 1);
-    let kind = if mixture.interior() && isolated {
-        GenericKind::Outliers(samples.clone())
-    } else {
-        GenericKind::Tails {
-            samples: samples.clone(),
-            share: mixture.share,
-            width: mixture.wide / mixture.core,
-        }
-    };
     let mut fitted = DVector::zeros(ctx.m());
     for &i in &samples {
         fitted[c * n + i] = ctx.y[c * n + i];
     }
+    let kind = if mixture.isolated_outliers(&samples) {
+        GenericKind::Outliers(samples)
+    } else {
+        GenericKind::Tails {
+            samples,
+            share: mixture.share,
+            width: mixture.wide / mixture.core,
+        }
+    };
     let explained = Explained {
         gain: mixture.gain,
         rank: 2,
@@ -184,19 +187,22 @@ pub(super) fn evidence(ctx: &Context, c: usize) -> Option<Outliers> {
     })
 }
 
-/// The verdict's `where` (the samples themselves) and its sentence where isolated outliers on
-/// channel `c` lead.
+/// The verdict's `where`: the samples themselves, each a span of one instant on channel `c`.
+fn spans(ctx: &Context, c: usize, samples: &[usize]) -> Vec<Span> {
+    samples
+        .iter()
+        .map(|&i| Span {
+            channel: ctx.channels[c].clone(),
+            t_start: ctx.times[i],
+            t_end: ctx.times[i],
+        })
+        .collect()
+}
+
+/// The verdict's `where` and its sentence where isolated outliers on channel `c` lead.
 pub(super) fn reported(ctx: &Context, c: usize, samples: &[usize]) -> (Vec<Span>, String) {
     let at: Vec<f64> = samples.iter().map(|&i| ctx.times[i]).collect();
-    let spans = at
-        .iter()
-        .map(|&t| Span {
-            channel: ctx.channels[c].clone(),
-            t_start: t,
-            t_end: t,
-        })
-        .collect();
-    (spans, suggestion(&ctx.channels[c], &at))
+    (spans(ctx, c, samples), suggestion(&ctx.channels[c], &at))
 }
 
 /// The verdict's `where` and its sentence where a noise of two scales on channel `c` leads: a
@@ -208,7 +214,6 @@ pub(super) fn tails_reported(
     share: f64,
     width: f64,
 ) -> (Vec<Span>, String) {
-    let (spans, _) = reported(ctx, c, samples);
     let channel = &ctx.channels[c];
     let sentence = format!(
         "{channel}'s residual is not one normal noise: {} of its samples lie in a part about \
@@ -223,7 +228,7 @@ pub(super) fn tails_reported(
             ""
         },
     );
-    (spans, sentence)
+    (spans(ctx, c, samples), sentence)
 }
 
 /// The sentence: how many, where, and what to do.
@@ -287,8 +292,7 @@ mod tests {
         let y: Vec<f64> = y.iter().map(|v| v / rms).collect();
         let m = contaminated_normal(&y).expect("a contaminated normal");
         let flagged: Vec<usize> = (0..y.len()).filter(|&i| m.r[i] > 0.5).collect();
-        let isolated = flagged.windows(2).all(|w| w[1] > w[0] + 1);
-        assert!(!(m.interior() && isolated), "{flagged:?}");
+        assert!(!m.isolated_outliers(&flagged), "{flagged:?}");
         assert!(m.gain > (1002f64).ln() + 2.0 + 20.0, "gain {:.1}", m.gain);
     }
 
@@ -301,9 +305,9 @@ mod tests {
             y[i] += if k % 2 == 0 { 12.0 } else { -12.0 };
         }
         let m = contaminated_normal(&y).expect("a contaminated normal");
-        assert!(m.interior());
-        let (gain, r) = (m.gain, m.r);
-        let flagged: Vec<usize> = (0..y.len()).filter(|&i| r[i] > 0.5).collect();
+        let flagged: Vec<usize> = (0..y.len()).filter(|&i| m.r[i] > 0.5).collect();
+        assert!(m.isolated_outliers(&flagged));
+        let gain = m.gain;
         assert_eq!(flagged, at);
         assert!(gain > 100.0, "gain {gain:.1}");
     }

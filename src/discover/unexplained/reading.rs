@@ -119,14 +119,15 @@ pub(super) fn fingerprints(
                     .map(|&i| Column::new(CURRENT_LIMIT, Shape::CurrentLimit(i))),
             );
         }
-        if Some(c) == speed && READING_RIPPLE.iter().all(|&f| fresh(f)) {
+        // The angle's ripple each reading is offered: ω's scaled by the speed, I's alone.
+        let ripple = if Some(c) == speed {
+            READING_RIPPLE
+        } else {
+            RIPPLES[0]
+        };
+        if ripple.iter().all(|&f| fresh(f)) {
             for &h in harmonics {
-                columns.extend(READING_RIPPLE.map(|f| Column::new(f, Shape::Harmonic(h))));
-            }
-        }
-        if Some(c) == current && RIPPLES[0].iter().all(|&f| fresh(f)) {
-            for &h in harmonics {
-                columns.extend(RIPPLES[0].map(|f| Column::new(f, Shape::Harmonic(h))));
+                columns.extend(ripple.map(|f| Column::new(f, Shape::Harmonic(h))));
             }
         }
         let shapes: Vec<Shapes> = columns
