@@ -62,3 +62,5 @@ python3 $B/session19/case_table.py $T/all83 $T/n83 > $HERE/case-table-830000-ses
 (cd $B && python3 kind_table.py $T/all83:$T/tn83:session25/library-residual-830000.md) > $HERE/kind-table-830000-session25.md
 (cd $B && python3 rule_breaks.py $T/all83:$T/tn83:session25/library-residual-830000.md) > $HERE/rule-breaks-830000-session25.txt
 python3 $B/whole_commands.py $T/n83 $T/all83 > $HERE/whole-command-times-830000-session25.txt
+# 7. The pickups' truths as the law's coefficients beside each law, and the bursts' sentences.
+(cd $HERE && python3 pickup_truth.py $T/all82 $T/n82 > pickup-truth-820000-session25.txt)
