@@ -497,3 +497,38 @@ fn interference_bursts_on_the_current_are_not_nothing_missing() {
         bursts.len()
     );
 }
+
+/// The sampling instants jitter, 0.14 ms (sd) drawn afresh each sample (sample_jitter-830003):
+/// the residual stays white but its spread follows the slope, largest on the current's flanks
+/// after each step. That is no ringing (the verdict's leader before `slope_noise`, a 309-Hz
+/// oscillation of I at ζ 0.45) and no law: the fingerprint is `unknown`, its sentence the
+/// noise that follows the slope, its jitter's sd within 30% of the truth's.
+#[test]
+fn a_jittered_sampling_clock_is_a_noise_that_follows_the_slope_not_a_ringing() {
+    let (problem, answer) = fixture("sample_jitter-830003");
+    let truth = truth_value(&answer, "s");
+    let d = whole_library(&problem);
+    let u = d
+        .unexplained
+        .expect("a jitter of 0.14 ms is not nothing missing");
+    assert!(
+        matches!(u.fingerprint, Fingerprint::Unknown { .. }),
+        "{:?}",
+        u.fingerprint
+    );
+    let at = u
+        .suggestion
+        .find("off by about ")
+        .unwrap_or_else(|| panic!("{}", u.suggestion));
+    let micro: f64 = u.suggestion[at + 13..]
+        .split(' ')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(
+        within(micro * 1e-6, truth, 0.3),
+        "{micro} µs against {:.1}",
+        truth * 1e6
+    );
+}

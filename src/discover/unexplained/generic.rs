@@ -1,7 +1,7 @@
 //! The generic alternatives' results, and what the report says where one of them leads.
 
 use super::spans::Span;
-use super::{Context, Scored, outliers};
+use super::{Context, Scored, outliers, slope_noise};
 
 /// A generic alternative's result on a channel.
 #[derive(Clone)]
@@ -30,6 +30,12 @@ pub(super) enum GenericKind {
         share: f64,
         width: f64,
     },
+    /// A noise that follows the slope (`slope_noise`): the sampling instants' jitter, its sd
+    /// [s], and the channels (indices) it is shared by.
+    SlopeNoise {
+        seconds: f64,
+        channels: Vec<usize>,
+    },
 }
 
 impl Generic {
@@ -49,6 +55,10 @@ impl Generic {
             } => {
                 let (spans, sentence) =
                     outliers::tails_reported(ctx, self.channel, samples, *share, *width);
+                Some((Some(spans), sentence))
+            }
+            GenericKind::SlopeNoise { seconds, channels } => {
+                let (spans, sentence) = slope_noise::reported(ctx, *seconds, channels);
                 Some((Some(spans), sentence))
             }
             GenericKind::Lead => Some((

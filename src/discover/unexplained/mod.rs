@@ -11,7 +11,8 @@
 //! second-order filter that rings (a resonant sensor, `resonance`), a channel that runs ahead
 //! of the model (its derivative with a lead's sign: generic, no sensor leads, but a balance
 //! whose fast dynamics the model has too slow looks so), isolated samples far off (a
-//! contaminated normal of one channel's residual, `outliers`), and the state fingerprints of the
+//! contaminated normal of one channel's residual, `outliers`), a noise whose spread follows the
+//! slope (the sampling instants' jitter, `slope_noise`), and the state fingerprints of the
 //! balances and of what is read (`state`). Each is
 //! scored as the ranking scores a term: its linearised gain in log likelihood with the model's
 //! parameters refitted beside it (`regression`), less ½·ln N per degree of freedom, less the
@@ -43,6 +44,7 @@ mod quantized;
 mod reading;
 mod regression;
 mod resonance;
+mod slope_noise;
 mod spans;
 mod starts;
 mod state;
@@ -407,6 +409,13 @@ fn scores(ctx: &Context, shift: f64) -> Scores {
         }
         // The lag's next model: a sensor that rings.
         fingerprints.extend(resonance::evidence(ctx, c, lag, shift));
+    }
+    if let Some(j) = slope_noise::evidence(ctx) {
+        generic.push(Generic {
+            channel: j.channel,
+            kind: j.kind,
+            scored: j.scored,
+        });
     }
     // A delay: every channel late by the same τ.
     let mut d = DMatrix::zeros(ctx.m(), 1);
