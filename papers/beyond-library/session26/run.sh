@@ -90,3 +90,8 @@ done > $HERE/null-alarms-remade.txt
 (cd $HERE && python3 jitter_truth.py $P/all83 $T/n83 > jitter-truth-830000-session26.txt)
 (cd $HERE && python3 jitter_truth.py $T/h84 $T/n84 > jitter-truth-840000-session26.txt)
 (cd $HERE && python3 jitter_truth.py $T/h84 $T/n84-base > jitter-truth-840000-39de1a3.txt)
+# 8. The slowest of the 118 by each build in one quiet run, alternating, three times each.
+C=$(ls -d $S/hold/h*/bearing_defect-760002)
+for k in 1 2 3; do for b in 39de1a3:$BASE session26:$BIN; do
+  /usr/bin/time -f "${b%%:*} run $k: %e s wall" ${b#*:} diagnose --quiet --data $C/recording.csv --model $C/motor.toml --json $T/time-${b%%:*}.json > /dev/null 2>> $HERE/timing-760002-one-run.txt
+done; done
