@@ -257,7 +257,7 @@ impl Context {
         self.times
             .iter()
             .map(|&t| {
-                let k = ((t / h).round() as usize).clamp(1, y.len() - 2);
+                let k = self.fine.interior_index(t);
                 (y[k + 1] - y[k - 1]) / (2.0 * h) / self.sigma[c]
             })
             .collect()

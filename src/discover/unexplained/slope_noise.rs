@@ -22,7 +22,7 @@ use nalgebra::DVector;
 
 use super::generic::GenericKind;
 use super::regression::{Explained, golden_max};
-use super::spans::Span;
+use super::spans::{Span, runs};
 use super::{Context, Scored};
 
 /// The jitter's sd searched, as shares of the sampling interval Δ: from a thousandth (under any
@@ -53,7 +53,7 @@ fn slopes(ctx: &Context, c: usize) -> Vec<f64> {
     ctx.times
         .iter()
         .map(|&t| {
-            let k = ((t / h).round() as usize).clamp(1, y.len() - 2);
+            let k = ctx.fine.interior_index(t);
             let (before, after) = ((y[k] - y[k - 1]) / h, (y[k + 1] - y[k]) / h);
             let rms = (0.5 * (before * before + after * after)).sqrt();
             rms.copysign(before + after) / ctx.sigma[c]
@@ -61,23 +61,22 @@ fn slopes(ctx: &Context, c: usize) -> Vec<f64> {
         .collect()
 }
 
-/// The log likelihood of the whitened residuals `y` (one row per channel) under covariance
-/// diag(a²) + s²·d dᵀ per sample (d the whitened slopes), by Sherman–Morrison per sample.
-fn ln_likelihood(y: &[&[f64]], d: &[&[f64]], s: f64, a: &[f64]) -> f64 {
+/// The log likelihood of the whitened residuals `y` (one row per channel, at the model's unit
+/// scales) under covariance 1 + s²·d dᵀ per sample (d the whitened slopes), by Sherman–Morrison.
+fn ln_likelihood(y: &[&[f64]], d: &[&[f64]], s: f64) -> f64 {
     let n = y[0].len();
     let mut total = 0.0;
     for i in 0..n {
         let (mut ee, mut ez, mut zz) = (0.0, 0.0, 0.0);
         for k in 0..y.len() {
-            let z = y[k][i] / a[k];
-            let e = s * d[k][i] / a[k];
+            let e = s * d[k][i];
             ee += e * e;
-            ez += e * z;
-            zz += z * z;
+            ez += e * y[k][i];
+            zz += y[k][i] * y[k][i];
         }
         total -= 0.5 * (zz - ez * ez / (1.0 + ee) + (1.0 + ee).ln());
     }
-    total - n as f64 * a.iter().map(|v| v.ln()).sum::<f64>()
+    total
 }
 
 /// The maximum-likelihood fit to the whitened residuals `y` with slopes `d` (rows channels),
@@ -87,17 +86,16 @@ fn ln_likelihood(y: &[&[f64]], d: &[&[f64]], s: f64, a: &[f64]) -> f64 {
 /// alternatives it is ranked against do not get (a lag's deterministic residual, which a
 /// variance that follows the slope holds in part, would then lose to it).
 fn fit(y: &[&[f64]], d: &[&[f64]], dt: f64) -> (f64, f64) {
-    let unit = vec![1.0; y.len()];
-    let single = ln_likelihood(y, d, 0.0, &unit);
+    let single = ln_likelihood(y, d, 0.0);
     let (lo, hi) = ((S_RANGE.0 * dt).ln(), (S_RANGE.1 * dt).ln());
-    let at = |u: f64| ln_likelihood(y, d, u.exp(), &unit);
+    let at = |u: f64| ln_likelihood(y, d, u.exp());
     let step = (hi - lo) / (GRID - 1) as f64;
     let on_grid = (0..GRID)
         .map(|k| lo + step * k as f64)
         .max_by(|&u, &v| at(u).total_cmp(&at(v)))
         .unwrap_or(lo);
     let s = golden_max((on_grid - step).max(lo), (on_grid + step).min(hi), 40, at).exp();
-    (ln_likelihood(y, d, s, &unit) - single, s)
+    (ln_likelihood(y, d, s) - single, s)
 }
 
 /// The evidence of a noise that follows the slope on the residual `ctx` holds: the best of one
@@ -170,27 +168,13 @@ pub(super) fn evidence(ctx: &Context) -> Option<SlopeNoise> {
 /// The verdict's `where` and its sentence where the noise that follows the slope leads: the
 /// stretches where the jitter's part of the spread exceeds the noise's, and what to do.
 pub(super) fn reported(ctx: &Context, seconds: f64, cs: &[usize]) -> (Vec<Span>, String) {
-    let n = ctx.n;
-    let mut spans = Vec::new();
-    for &c in cs {
-        let d = slopes(ctx, c);
-        let mut start: Option<usize> = None;
-        for i in 0..=n {
-            let steep = i < n && (seconds * d[i]).abs() > 1.0;
-            match (steep, start) {
-                (true, None) => start = Some(i),
-                (false, Some(a)) => {
-                    spans.push(Span {
-                        channel: ctx.channels[c].clone(),
-                        t_start: ctx.times[a],
-                        t_end: ctx.times[i - 1],
-                    });
-                    start = None;
-                }
-                _ => {}
-            }
-        }
-    }
+    let spans = cs
+        .iter()
+        .flat_map(|&c| {
+            let d = slopes(ctx, c);
+            runs(ctx, c, 0.0, |i| (seconds * d[i]).abs() > 1.0)
+        })
+        .collect();
     let names: Vec<&str> = cs.iter().map(|&c| ctx.channels[c].as_str()).collect();
     let sentence = format!(
         "the residual's spread on {} grows where the channel{} change{} fast, as if each \

@@ -19,19 +19,30 @@ pub struct Span {
 /// at least `MISMATCH_MIN_SHARE` of the record.
 pub(super) fn spans(ctx: &Context, c: usize, e: &Explained) -> Vec<Span> {
     let n = ctx.n;
+    runs(ctx, c, MISMATCH_MIN_SHARE, |i| {
+        let k = c * n + i;
+        e.fitted[k].abs() > 2.0 * e.fitted_sd[k]
+    })
+}
+
+/// The runs of consecutive samples of channel c where `off` holds, as intervals lasting at least
+/// `min_share` of the record.
+pub(super) fn runs(
+    ctx: &Context,
+    c: usize,
+    min_share: f64,
+    off: impl Fn(usize) -> bool,
+) -> Vec<Span> {
+    let n = ctx.n;
     let duration = ctx.times[n - 1] - ctx.times[0];
     let mut out = Vec::new();
     let mut start: Option<usize> = None;
     for i in 0..=n {
-        let off = i < n && {
-            let k = c * n + i;
-            e.fitted[k].abs() > 2.0 * e.fitted_sd[k]
-        };
-        match (off, start) {
+        match (i < n && off(i), start) {
             (true, None) => start = Some(i),
             (false, Some(s)) => {
                 let (a, b) = (ctx.times[s], ctx.times[i - 1]);
-                if b - a >= MISMATCH_MIN_SHARE * duration {
+                if b - a >= min_share * duration {
                     out.push(Span {
                         channel: ctx.channels[c].clone(),
                         t_start: a,

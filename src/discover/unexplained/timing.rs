@@ -68,6 +68,11 @@ impl FinePrediction {
         self.times[1] - self.times[0]
     }
 
+    /// The fine grid's point nearest t, kept off the ends so that it has neighbours both sides.
+    pub(super) fn interior_index(&self, t: f64) -> usize {
+        ((t / self.step()).round() as usize).clamp(1, self.times.len() - 2)
+    }
+
     /// Channel c's integral from t = 0 on the fine grid (trapezoids).
     pub(super) fn integral(&self, c: usize) -> Vec<f64> {
         let y = &self.channels[c];
