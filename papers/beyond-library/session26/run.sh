@@ -95,3 +95,10 @@ C=$(ls -d $S/hold/h*/bearing_defect-760002)
 for k in 1 2 3; do for b in 39de1a3:$BASE session26:$BIN; do
   /usr/bin/time -f "${b%%:*} run $k: %e s wall" ${b#*:} diagnose --quiet --data $C/recording.csv --model $C/motor.toml --json $T/time-${b%%:*}.json > /dev/null 2>> $HERE/timing-760002-one-run.txt
 done; done
+# 9. The chance that two neighbours swap places under a jitter of sd s: Φ(−Δ/(√2·s)), quoted for
+#    the search's cap in slope_noise.rs and the section.
+python3 -c "
+import math
+for share in (0.25, 0.5, 1.0):
+    print(f's = {share}·Δ: P(swap) = {0.5 * math.erfc(1 / (math.sqrt(2) * share) / math.sqrt(2)):.4f}')
+" > $HERE/swap-chance.txt
