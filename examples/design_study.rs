@@ -185,8 +185,14 @@ fn separate(
     );
     for g in &d.gaps {
         println!(
-            "  {} as truth over {}: {:.2} ± {:.2} (noise-free {:.2})",
-            g.truth, g.rival, g.expected_gap_nats, g.sd_nats, g.noise_free_gap_nats
+            "  {} as truth over {}: {:.2} ± {:.2}, σ estimated (at the σ given {:.2}; noise-free \
+             {:.2})",
+            g.truth,
+            g.rival,
+            g.expected_gap_nats,
+            g.sd_nats,
+            g.known_sigma_gap_nats,
+            g.noise_free_gap_nats
         );
     }
     for f in &d.fixed_experiments {
@@ -199,7 +205,7 @@ fn separate(
     for (t, truth) in experiment.candidates.iter().enumerate() {
         let motor = truth.problem.model.model(input.clone())?;
         let (mut named, mut clear) = (0, 0);
-        let mut selected = Vec::new();
+        let (mut selected, mut leads) = (Vec::new(), Vec::new());
         for k in 0..records {
             let data = generate(&motor, &times, &[2.0, 10.0], 7000 + k as u64)?;
             let recording =
@@ -229,13 +235,17 @@ fn separate(
                 settings.run.quiet = true;
                 selected.push(discover(&problem, &settings)?.selected);
             }
+            leads.push(lead);
             named += usize::from(lead > 0.0);
             clear += usize::from(lead > EVIDENCE_THRESHOLD);
         }
         println!(
             "  {} as truth, {records} records on the designed input: scores highest in {named}, \
-             by more than {EVIDENCE_THRESHOLD} nats in {clear}",
-            truth.name
+             by more than {EVIDENCE_THRESHOLD} nats in {clear}; its lead over the best other \
+             {:.2} ± {:.2} nats",
+            truth.name,
+            mean(&leads),
+            sd(&leads)
         );
         if diagnosed > 0 {
             let hits = selected.iter().filter(|s| **s == truth.name).count();
@@ -405,4 +415,8 @@ fn sd(v: &[f64]) -> f64 {
     let n = v.len() as f64;
     let mean = v.iter().sum::<f64>() / n;
     (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
+}
+
+fn mean(x: &[f64]) -> f64 {
+    x.iter().sum::<f64>() / x.len().max(1) as f64
 }

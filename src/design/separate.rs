@@ -3,7 +3,8 @@
 //! oracle's Levenberg–Marquardt); the truth's expected score lead over the best-fitting rival is
 //! ½·SS/σ² + ½·(d_rival − d_truth)·ln N nats, the score `diagnose` ranks by. The search
 //! maximises the smallest lead over the truths; the reported gap repeats the comparison on
-//! noisy records (noise and parameter draws), each candidate refitted.
+//! noisy records (noise and parameter draws), each candidate refitted and scored as `diagnose`
+//! scores it: with each channel's σ estimated from the record, not given ([`profiled`]).
 
 use nalgebra::{DMatrix, DVector};
 use rand::SeedableRng;
@@ -153,15 +154,19 @@ pub struct ExpectedGap {
     /// The rival that fits the noise-free prediction best.
     pub rival: String,
     pub noise_free_gap_nats: f64,
+    /// The mean lead with σ estimated per channel, as `diagnose` ranks.
     pub expected_gap_nats: f64,
     pub sd_nats: f64,
+    /// The same records scored at the σ given (what the search's objective assumes): far above
+    /// `expected_gap_nats` where a rival misfits by many σ, since `diagnose`'s σ̂ then grows.
+    pub known_sigma_gap_nats: f64,
     pub draws: usize,
 }
 
 /// For each truth: records simulated at parameter draws (Gaussian at its estimate with the
 /// covariance this input's Fisher matrix leaves) plus noise at σ, the truth and every rival
-/// refitted (from their noise-free fits), and the truth's score lead over the best rival;
-/// mean and sd over `draws` records. Draw k of truth a uses its own seeded stream, so the
+/// refitted (from their noise-free fits), and the truth's score lead over the best rival with
+/// σ estimated ([`profiled`]); mean and sd over `draws` records, and the mean at σ given. Draw k of truth a uses its own seeded stream, so the
 /// result does not depend on the thread count.
 pub fn expected_gaps(
     experiment: &Experiment,
@@ -188,9 +193,9 @@ pub fn expected_gaps(
             .iter()
             .map(|c| c.forward(input, &experiment.times))
             .collect::<Result<Vec<_>, _>>()?;
-        let gaps: Vec<f64> = (0..draws)
+        let gaps: Vec<(f64, f64)> = (0..draws)
             .into_par_iter()
-            .map(|k| -> Result<f64, Error> {
+            .map(|k| -> Result<(f64, f64), Error> {
                 let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(
                     seed ^ (0x5eed_0000 + (a as u64) * 1_000_003 + k as u64),
                 );
@@ -201,40 +206,73 @@ pub fn expected_gaps(
                     let e: f64 = StandardNormal.sample(&mut rng);
                     *v += e / w;
                 }
-                let (ss_truth, _) =
+                let m = experiment.times.len();
+                let (ss_truth, theta_truth) =
                     levenberg_marquardt(&forward, &specs, &y, &weights, truth.theta.clone())?;
-                let mut best = f64::INFINITY;
+                let p_truth = profiled(&forward, &specs, &y, m, theta_truth)?;
+                let (mut best, mut best_known) = (f64::INFINITY, f64::INFINITY);
                 for (b, rival) in candidates.iter().enumerate() {
                     if b == a {
                         continue;
                     }
                     let f = &forwards[b];
-                    let (ss, _) = levenberg_marquardt(
-                        f,
-                        &f.calibrated_specs(),
-                        &y,
-                        &weights,
-                        fits[a][b].clone(),
-                    )?;
-                    let d = rival.theta.len() as f64 - truth.theta.len() as f64;
-                    best = best.min(0.5 * (ss - ss_truth) + 0.5 * d * ln_n);
+                    let rival_specs = f.calibrated_specs();
+                    let (ss, theta) =
+                        levenberg_marquardt(f, &rival_specs, &y, &weights, fits[a][b].clone())?;
+                    let p_rival = profiled(f, &rival_specs, &y, m, theta)?;
+                    let penalty =
+                        0.5 * (rival.theta.len() as f64 - truth.theta.len() as f64) * ln_n;
+                    best = best.min(p_truth - p_rival + penalty);
+                    best_known = best_known.min(0.5 * (ss - ss_truth) + penalty);
                 }
-                Ok(best)
+                Ok((best, best_known))
             })
             .collect::<Result<_, _>>()?;
         let n = gaps.len().max(1) as f64;
-        let mean = gaps.iter().sum::<f64>() / n;
-        let var = gaps.iter().map(|g| (g - mean).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
+        let mean = gaps.iter().map(|g| g.0).sum::<f64>() / n;
+        let var = gaps.iter().map(|g| (g.0 - mean).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
         out.push(ExpectedGap {
             truth: truth.name.clone(),
             rival: candidates[lead.rival].name.clone(),
             noise_free_gap_nats: lead.gap,
             expected_gap_nats: mean,
             sd_nats: var.sqrt(),
+            known_sigma_gap_nats: gaps.iter().map(|g| g.1).sum::<f64>() / n,
             draws,
         });
     }
     Ok(out)
+}
+
+/// The log likelihood of `y` with each channel's σ estimated, maximised over θ and σ from
+/// `theta` (a fit at the σ given), up to a constant: −Σ_c (m/2)·ln(SS_c/m), SS_c channel c's
+/// sum of squares over its m samples. `diagnose` fits σ with θ, so a rival that misfits raises
+/// its own σ̂ and loses ln σ̂ per sample, not the squared misfit over σ². One majorise–minimise
+/// step refits θ at the σ̂ its residuals give (ln SS_c lies below its tangent at the current
+/// SS_c, so the weighted fit at weights 1/σ̂_c never lowers it); the better of the two is kept.
+fn profiled(
+    forward: &crate::forward::ForwardModel,
+    specs: &[ParameterSpec],
+    y: &[f64],
+    m: usize,
+    theta: Vec<f64>,
+) -> Result<f64, Error> {
+    let log_likelihood = |theta: &[f64]| -> Result<(f64, Vec<f64>), Error> {
+        let mut g = vec![0.0; y.len()];
+        forward.simulate(theta, &mut g).map_err(numerical)?;
+        let (mut value, mut weights) = (0.0, Vec::with_capacity(y.len()));
+        for (channel, fit) in y.chunks(m).zip(g.chunks(m)) {
+            let ss: f64 = channel.iter().zip(fit).map(|(a, b)| (a - b).powi(2)).sum();
+            let sigma2 = (ss / m as f64).max(f64::MIN_POSITIVE);
+            value -= 0.5 * m as f64 * sigma2.ln();
+            weights.extend(std::iter::repeat_n(1.0 / sigma2.sqrt(), m));
+        }
+        Ok((value, weights))
+    };
+    let (first, weights) = log_likelihood(&theta)?;
+    let (_, refit) = levenberg_marquardt(forward, specs, y, &weights, theta)?;
+    let (second, _) = log_likelihood(&refit)?;
+    Ok(first.max(second))
 }
 
 /// The Cholesky factor of the inverse Fisher matrix at θ (`None` when it is singular: the

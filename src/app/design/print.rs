@@ -78,11 +78,13 @@ pub(super) fn print_summary(report: &Value, out: &Path) {
         );
         for g in report["gaps"].as_array().into_iter().flatten() {
             println!(
-                "  {} as truth over {}: {} ± {} nats (noise-free {})",
+                "  {} as truth over {}: {} ± {} nats, σ estimated (at the σ given {}; \
+                 noise-free {})",
                 g["truth"].as_str().unwrap_or(""),
                 g["rival"].as_str().unwrap_or(""),
                 f(&g["expected_gap_nats"]),
                 f(&g["sd_nats"]),
+                f(&g["known_sigma_gap_nats"]),
                 f(&g["noise_free_gap_nats"])
             );
         }
