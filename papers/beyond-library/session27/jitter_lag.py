@@ -5,7 +5,7 @@ Usage: jitter_lag.py REPORT.json..."""
 import json
 import sys
 
-print("case | selected | its score over none | as-given leader (score) | as-given alternatives | leader − selected's score | verdict")
+print("case | selected | its score over none | as-given leader (score) | as-given alternatives | leader − selected's score | verdict | the leader's τ ± sd [ms]")
 for path in sys.argv[1:]:
     r = json.load(open(path))
     none = next(e["score"] for e in r["ranking"] if e["effect"] == "none")
@@ -17,4 +17,5 @@ for path in sys.argv[1:]:
     u = r["unexplained"]
     name = path.rsplit("/", 1)[-1].removesuffix(".json")
     print(f"{name} | {r['selected']} | {chosen - none:.2f} | {f.get('kind')} {f.get('channel', '')} ({lead:.2f}) | {alts or '—'} | "
-          f"{lead - (chosen - none):+.2f} | {u and u['fingerprint']['kind']}")
+          f"{lead - (chosen - none):+.2f} | {u and u['fingerprint']['kind']} | "
+          + (f"{f['seconds'] * 1e3:.3f} ± {f['sd'] * 1e3:.3f}" if "seconds" in f else "—"))
