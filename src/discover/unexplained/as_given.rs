@@ -21,6 +21,9 @@ pub struct AsGiven {
     scores: Option<Scores>,
     /// Below this frequency (Hz) an oscillation on the record is a trend.
     lowest_frequency: f64,
+    /// Its whitened residual (stacked channel after channel), for the figure of an
+    /// alternative found on it.
+    residual: Vec<f64>,
 }
 
 impl AsGiven {
@@ -30,6 +33,7 @@ impl AsGiven {
             laws: Vec::new(),
             scores: None,
             lowest_frequency: f64::INFINITY,
+            residual: Vec::new(),
         };
         if problem.recordings.is_empty() {
             return Ok(nothing);
@@ -42,12 +46,18 @@ impl AsGiven {
             laws: state::fingerprints(none, &ctx, 0.0)?,
             scores: Some(scores(&ctx, 0.0)),
             lowest_frequency: oscillation::lowest_frequency(&ctx),
+            residual: ctx.y.as_slice().to_vec(),
         })
     }
 
     /// Below this frequency (Hz) an oscillation on the record is a trend.
     pub fn lowest_frequency(&self) -> f64 {
         self.lowest_frequency
+    }
+
+    /// Its whitened residual, empty where the verdict is not asked.
+    pub(super) fn residual(&self) -> &[f64] {
+        &self.residual
     }
 
     /// The laws' fingerprints.

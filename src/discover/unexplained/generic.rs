@@ -38,6 +38,16 @@ pub(super) enum GenericKind {
     },
 }
 
+impl GenericKind {
+    /// A model of the noise, not of its mean: no term or law holds what it finds.
+    pub fn is_noise(&self) -> bool {
+        matches!(
+            self,
+            GenericKind::Outliers(_) | GenericKind::Tails { .. } | GenericKind::SlopeNoise { .. }
+        )
+    }
+}
+
 impl Generic {
     /// Where this alternative leads the verdict: the report's `where` and sentence, where its
     /// kind says more than the fingerprint's `unknown` does; none otherwise.

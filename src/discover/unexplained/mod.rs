@@ -284,6 +284,11 @@ pub fn unexplained(
         Some(s) if selected.added.is_empty() => s,
         _ => scores(&ctx, 0.0),
     };
+    // The noise models among the model as given's generic alternatives, against what the
+    // selected terms gained: no term holds a noise's shape, so a term that gained less than
+    // one of them did (a jitter's few late samples on the current's flanks fitted as a lag)
+    // is no evidence that the noise is what the model assumes.
+    let mut noise_on_none: Vec<Generic> = Vec::new();
     if selected.added.is_empty() {
         all.fingerprints.extend(as_given.shifted(0.0));
     } else {
@@ -300,18 +305,25 @@ pub fn unexplained(
         };
         all.fingerprints.extend(on_none.fingerprints);
         all.fingerprints.extend(as_given.shifted(shift));
+        noise_on_none = (on_none.generic.into_iter())
+            .filter(|g| g.kind.is_noise())
+            .collect();
     }
-    let best_generic = all
-        .generic
-        .iter()
+    let on_none = |g: &Generic| noise_on_none.iter().any(|n| std::ptr::eq(n, g));
+    let best_generic = (all.generic.iter())
+        .chain(&noise_on_none)
         .max_by(|a, b| a.scored.score.total_cmp(&b.scored.score));
     let mut candidates: Vec<Evidence> = all.fingerprints;
     if let Some(g) = best_generic {
+        let residual = match on_none(g) && !as_given.residual().is_empty() {
+            true => as_given.residual(),
+            false => ctx.y.as_slice(),
+        };
         candidates.push(Evidence {
             fingerprint: Fingerprint::Unknown {
                 score: g.scored.score,
             },
-            residual: ctx.y.as_slice().to_vec(),
+            residual: residual.to_vec(),
             explained: g.scored.explained.fitted.as_slice().to_vec(),
         });
     }
@@ -374,9 +386,8 @@ pub fn unexplained(
     let mut channels = Vec::new();
     let mut where_ = Vec::new();
     for c in 0..ctx.channels.len() {
-        let best = all
-            .generic
-            .iter()
+        let best = (all.generic.iter())
+            .chain(&noise_on_none)
             .filter(|g| g.channel == c)
             .max_by(|a, b| a.scored.score.total_cmp(&b.scored.score));
         if best.is_some_and(|g| g.scored.score > EVIDENCE_THRESHOLD) {
@@ -398,7 +409,14 @@ pub fn unexplained(
     if let (Fingerprint::Unknown { .. }, Some(g)) = (&fingerprint, best_generic)
         && let Some((spans, sentence)) = g.reported(&ctx)
     {
-        suggestion = sentence;
+        suggestion = match on_none(g) {
+            true => format!(
+                "{sentence}; seen on the model as given, where it explains {:.1} nats more \
+                 than the selected terms gained",
+                g.scored.score
+            ),
+            false => sentence,
+        };
         if let Some(spans) = spans {
             where_ = spans;
         }
