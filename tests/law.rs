@@ -297,6 +297,8 @@ fn the_dictionary_at_one_point_gives_each_shared_factor_its_own_formula_in_any_o
         frequency: 74.8,
         harmonic: 6.0,
         current_limit: 200.0,
+        spot_angle: 2.4,
+        spot_width: 0.3,
     };
     // A direction through every state at once, so a factor taken for another one shows.
     let x = Point {
@@ -331,6 +333,11 @@ fn the_dictionary_at_one_point_gives_each_shared_factor_its_own_formula_in_any_o
             "cos(2*pi*f*t)" => Dual64::from(phase.cos()),
             "U*sin(2*pi*f*t)" => x.voltage * phase.sin(),
             "U*cos(2*pi*f*t)" => x.voltage * phase.cos(),
+            // Not a shared factor: the spot's own formula, in its name's cos.
+            "omega*exp(-2*(1-cos(theta-theta_0))/w^2)" => {
+                let w2 = shapes.spot_width * shapes.spot_width;
+                x.speed * (((x.theta - shapes.spot_angle).cos() - 1.0) * (2.0 / w2)).exp()
+            }
             other => panic!("{other} is not a shared factor's function"),
         }
     };
@@ -340,7 +347,7 @@ fn the_dictionary_at_one_point_gives_each_shared_factor_its_own_formula_in_any_o
             name.contains("sign(omega)") || name.contains("sin") || name.contains("cos")
         })
         .collect();
-    assert_eq!(shared.len(), 13);
+    assert_eq!(shared.len(), 14);
     for order in [shared.clone(), shared.iter().rev().copied().collect()] {
         let here = At::new(&x, &shapes);
         for &f in &order {

@@ -1,5 +1,6 @@
 //! The law the diagnosis discovered, as the report states it: its balance, functions, their
-//! coefficients with 95% intervals, and the shapes (ω_s, k, I_lim, f) it holds.
+//! coefficients with 95% intervals, and the shapes (ω_s, k, I_lim, f, a spot's θ₀ and w) it
+//! holds.
 
 use std::collections::BTreeMap;
 
@@ -7,11 +8,12 @@ use serde::Serialize;
 
 use crate::motor::Term;
 use crate::motor::dictionary::{
-    self, BALANCES, CURRENT_LIMIT, FUNCTIONS, N_FUNCTIONS, STRIBECK, reads_harmonic,
+    self, BALANCES, CURRENT_LIMIT, FUNCTIONS, N_FUNCTIONS, OMEGA_SPOT, STRIBECK, Spot,
+    reads_harmonic,
 };
 
 use super::candidate::Candidate;
-use super::unexplained::{EquationTerm, equation_with, with_shapes};
+use super::unexplained::{EquationTerm, equation_with, with_shapes, with_spot};
 
 /// One function of a discovered law: its coefficient at the MAP and the 95% interval of the
 /// Laplace approximation there (MAP ± 1.96 sd; the coefficients have real support, so the
@@ -43,6 +45,9 @@ pub struct Discovered {
     /// The frequency f [Hz] of a periodic law, where it holds sin or cos(2πft).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub frequency_hz: Option<f64>,
+    /// The spot's θ₀ and w [rad] (`theta_0`, `w`), where the law holds a spot of the angle.
+    #[serde(flatten, skip_serializing_if = "Option::is_none")]
+    pub spot: Option<Spot>,
     /// The law as the report prints it, e.g. `J dω/dt += −0.0001·sign(ω)·|I| [95%: …]`.
     pub equation: String,
 }
@@ -83,8 +88,10 @@ pub fn discovered(fit: &Candidate, gained: f64) -> Option<Discovered> {
         .any(|f| dictionary::reads_frequency(f) && holds(f))
         .then_some(law.shapes.frequency);
     let current_limit = holds(CURRENT_LIMIT).then_some(law.shapes.current_limit);
+    let spot = holds(OMEGA_SPOT).then(|| Spot::of(&law.shapes));
     let mut law = Discovered {
         equation: String::new(),
+        spot,
         omega_s,
         k,
         current_limit,
@@ -104,11 +111,14 @@ impl Discovered {
             .iter()
             .map(|f| (f.name.clone(), f.coefficient, Some((f.q025, f.q975))))
             .collect();
-        self.equation = with_shapes(
-            equation_with(&self.balance, &terms),
-            self.k,
-            self.current_limit,
-            self.frequency_hz,
+        self.equation = with_spot(
+            with_shapes(
+                equation_with(&self.balance, &terms),
+                self.k,
+                self.current_limit,
+                self.frequency_hz,
+            ),
+            self.spot,
         );
     }
 

@@ -19,8 +19,8 @@ use rayon::prelude::*;
 use crate::error::Error;
 use crate::motor::Term;
 use crate::motor::dictionary::{
-    self, BALANCES, CURRENT_LIMIT, FUNCTIONS, N_FUNCTIONS, ODE_BALANCES, PERIODIC, RIPPLES,
-    STRIBECK, SUPPLY_RIPPLE, reads_frequency, reads_harmonic, ripple_of,
+    self, BALANCES, CURRENT_LIMIT, FUNCTIONS, N_FUNCTIONS, ODE_BALANCES, OMEGA_SPOT, PERIODIC,
+    RIPPLES, STRIBECK, SUPPLY_RIPPLE, reads_frequency, reads_harmonic, ripple_of,
 };
 use crate::motor::terms::Law;
 use crate::parameter::ParamId;
@@ -301,7 +301,7 @@ pub fn named_term(problem: &Problem, fingerprint: &Fingerprint) -> Option<NamedT
                     ..
                 } => {
                     // A k the order search found pays its grid, as a searched frequency does,
-                    // and is refined through the ODE.
+                    // and is refined through the ODE; a spot's (θ₀, w) pays its grid, unrefined.
                     search_penalty = *harmonic_price;
                     harmonic_search = (*harmonic_width > 0.0).then_some(*harmonic_width);
                     (balance, functions, *omega_s, *harmonic, *current_limit)
@@ -331,6 +331,9 @@ pub fn named_term(problem: &Problem, fingerprint: &Fingerprint) -> Option<NamedT
             }
             if let Some(i) = current_limit {
                 law.shapes.current_limit = i;
+            }
+            if let Fingerprint::State { spot: Some(p), .. } = fingerprint {
+                (law.shapes.spot_angle, law.shapes.spot_width) = (p.theta_0, p.w);
             }
             (Term::Law(law), start)
         }
@@ -508,6 +511,10 @@ fn extended(held: &Law, more: &Law) -> Law {
     }
     if !has(held, &[CURRENT_LIMIT]) && has(more, &[CURRENT_LIMIT]) {
         law.shapes.current_limit = more.shapes.current_limit;
+    }
+    if !has(held, &[OMEGA_SPOT]) && has(more, &[OMEGA_SPOT]) {
+        (law.shapes.spot_angle, law.shapes.spot_width) =
+            (more.shapes.spot_angle, more.shapes.spot_width);
     }
     law
 }

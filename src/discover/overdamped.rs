@@ -40,6 +40,7 @@ fn crosstalk() -> Fingerprint {
         omega_s: None,
         harmonic: None,
         current_limit: None,
+        spot: None,
         step: None,
         harmonic_price: 0.0,
         harmonic_width: 0.0,

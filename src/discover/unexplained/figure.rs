@@ -50,6 +50,7 @@ pub(super) fn folded(ctx: &Context, fingerprint: &Fingerprint, residual: &[f64])
         balance,
         harmonic,
         step,
+        spot,
         ..
     } = fingerprint
     else {
@@ -58,6 +59,8 @@ pub(super) fn folded(ctx: &Context, fingerprint: &Fingerprint, residual: &[f64])
     let n = ctx.n;
     let read = balance.strip_prefix("measurement:")?;
     let c = ctx.channels.iter().position(|c| c == read)?;
+    // A spot turns once a revolution.
+    let harmonic = harmonic.or(spot.map(|_| 1.0));
     let (periods, variable): (Vec<f64>, String) = match (step, harmonic) {
         (Some(q), _) => {
             let periods = ctx.times.iter().map(|&t| ctx.fine.at(c, t) / q).collect();

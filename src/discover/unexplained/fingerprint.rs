@@ -3,7 +3,7 @@
 
 use serde::Serialize;
 
-use crate::motor::dictionary;
+use crate::motor::dictionary::{self, Spot};
 
 /// One function of a state fingerprint: its dictionary name, the coefficient the linearised
 /// regression gives (the physical unit of the law's coefficient) and its sd.
@@ -64,6 +64,10 @@ pub enum Fingerprint {
         /// functions.
         #[serde(rename = "I_lim", skip_serializing_if = "Option::is_none")]
         current_limit: Option<f64>,
+        /// The spot's θ₀ and w of `omega*exp(-2*(1-cos(theta-theta_0))/w^2)`, where it is
+        /// one of the functions (`theta_0`, `w` in the JSON).
+        #[serde(flatten, skip_serializing_if = "Option::is_none")]
+        spot: Option<Spot>,
         /// The step q of `sin(2*pi*<channel>/q)`, `cos(2*pi*<channel>/q)` (in the channel's
         /// unit), where what is read is rounded to steps (`quantized`).
         #[serde(rename = "q", skip_serializing_if = "Option::is_none")]
@@ -204,6 +208,22 @@ impl Fingerprint {
                 balance.trim_start_matches("measurement:")
             ),
             Fingerprint::State {
+                balance,
+                functions,
+                spot: Some(spot),
+                ..
+            } => format!(
+                "what is read of {} is off over a span of {:.2} rad about θ = {:.2} rad, at the \
+                 same angle every revolution: {} fits what is left — an encoder line damaged or \
+                 missing, a worn segment of a tachogenerator's commutator (the term law, in \
+                 what is read); a record turning slowly through many revolutions would map the \
+                 spot's shape",
+                balance.trim_start_matches("measurement:"),
+                spot.w,
+                spot.theta_0,
+                with_spot(equation(balance, functions), Some(*spot))
+            ),
+            Fingerprint::State {
                 balance, functions, ..
             }
             | Fingerprint::Drift {
@@ -285,6 +305,17 @@ pub fn with_shapes(
         equation = equation.replace("2πft", &format!("2π·{f:.2}·t"));
     }
     equation
+}
+
+/// A spot's shape written into its equation: `exp(-2·(1-cos(θ-2.356))/0.196^2)` for θ₀ =
+/// 2.356 rad, w = 0.196 rad.
+pub fn with_spot(equation: String, spot: Option<Spot>) -> String {
+    match spot {
+        Some(s) => equation
+            .replace("θ-θ_0", &format!("θ-{:.3}", s.theta_0))
+            .replace("/w^2", &format!("/{:.3}^2", s.w)),
+        None => equation,
+    }
 }
 
 pub fn equation_with(balance: &str, terms: &[EquationTerm]) -> String {

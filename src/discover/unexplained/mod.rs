@@ -34,6 +34,7 @@
 //! are listed as alternatives.
 
 mod as_given;
+mod column;
 mod context;
 mod figure;
 mod fingerprint;
@@ -47,6 +48,7 @@ mod regression;
 mod resonance;
 mod slope_noise;
 mod spans;
+mod spot;
 mod starts;
 mod state;
 mod step_screen;
@@ -66,7 +68,9 @@ use super::settings::EVIDENCE_THRESHOLD;
 pub use as_given::AsGiven;
 pub use context::{Context, Scored};
 pub use figure::{FOLDED_BINS, Folded, UnexplainedFigure};
-pub use fingerprint::{EquationTerm, Fingerprint, LawFunction, equation_with, with_shapes};
+pub use fingerprint::{
+    EquationTerm, Fingerprint, LawFunction, equation_with, with_shapes, with_spot,
+};
 use generic::{Generic, GenericKind};
 pub use oscillation::{frequency_search_cost, lowest_frequency_over};
 pub use spans::Span;

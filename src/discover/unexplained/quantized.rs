@@ -93,6 +93,7 @@ pub(super) fn evidence(ctx: &Context, c: usize, shift: f64) -> Option<Evidence> 
             omega_s: None,
             harmonic: None,
             current_limit: None,
+            spot: None,
             step: Some(1.0 / nu),
             harmonic_price: 0.0,
             harmonic_width: 0.0,

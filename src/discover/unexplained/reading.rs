@@ -165,5 +165,7 @@ pub(super) fn fingerprints(
             |_: &Column| true,
         ));
     }
+    // And a spot of the angle on ω, a move of its own (its search paid by its price).
+    out.extend(super::spot::fingerprints(fit, ctx, shift));
     out
 }

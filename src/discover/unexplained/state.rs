@@ -51,6 +51,7 @@ use crate::motor::{ActiveTerm, MotorModel, Term};
 
 use super::super::candidate::Candidate;
 use super::super::settings::EVIDENCE_THRESHOLD;
+pub(super) use super::column::{Column, Harmonic, Shape};
 use super::fingerprint::LawFunction;
 use super::regression::{coefficient_sds, explain, gain};
 use super::{Context, Evidence, Fingerprint};
@@ -83,67 +84,6 @@ fn sampled_ripple(k: f64, speed: f64, interval: f64) -> bool {
     k * speed * interval < std::f64::consts::PI
 }
 
-/// A column of the regression: a function (dictionary index) and the shape it has, the
-/// Stribeck speed or the angle's harmonic.
-pub(super) struct Column {
-    pub function: usize,
-    pub shape: Shape,
-}
-
-impl Column {
-    pub fn new(function: usize, shape: Shape) -> Self {
-        Self { function, shape }
-    }
-
-    pub fn omega_s(&self) -> Option<f64> {
-        match self.shape {
-            Shape::StribeckSpeed(w) => Some(w),
-            _ => None,
-        }
-    }
-
-    pub fn harmonic(&self) -> Option<f64> {
-        match self.shape {
-            Shape::Harmonic(h) => Some(h.k),
-            _ => None,
-        }
-    }
-
-    pub fn current_limit(&self) -> Option<f64> {
-        match self.shape {
-            Shape::CurrentLimit(i) => Some(i),
-            _ => None,
-        }
-    }
-
-    /// What a move taking it pays on top of its ½·ln N and the step's look-elsewhere, for a
-    /// shape found by a search of its own (an order between the grid's, `order`: ln G).
-    pub fn price(&self) -> f64 {
-        match self.shape {
-            Shape::Harmonic(h) => h.price,
-            _ => 0.0,
-        }
-    }
-
-    /// For such a shape, the half-width of its refinement through the ODE (`named`).
-    pub fn width(&self) -> f64 {
-        match self.shape {
-            Shape::Harmonic(h) => h.width,
-            _ => 0.0,
-        }
-    }
-}
-
-/// A harmonic k of the angle offered, with what a column at it pays for its search (the
-/// grid's nothing: their number is in each step's look-elsewhere; the order search's ln G)
-/// and the half-width of its refinement through the ODE (0: none).
-#[derive(Clone, Copy, Debug)]
-pub(super) struct Harmonic {
-    pub k: f64,
-    pub price: f64,
-    pub width: f64,
-}
-
 /// The half-width of the search through the ODE around an order the order search found, as a
 /// share of the angle's Fourier spacing 1/R: the peak places k within a quarter of it.
 const SEARCH_WIDTH: f64 = 0.25;
@@ -157,26 +97,6 @@ pub fn whole_order(k: f64, width: f64) -> Option<f64> {
         .into_iter()
         .min_by(|a, b| (a - k).abs().total_cmp(&(b - k).abs()))
         .filter(|w| (w - k).abs() <= cell)
-}
-
-impl Harmonic {
-    fn on_grid(k: f64) -> Self {
-        Self {
-            k,
-            price: 0.0,
-            width: 0.0,
-        }
-    }
-}
-
-/// How a column (a block of them) shapes the law it is evaluated on.
-#[derive(Clone, Copy)]
-pub(super) enum Shape {
-    /// The model's law's shapes (or the dictionary's defaults).
-    Own,
-    StribeckSpeed(f64),
-    Harmonic(Harmonic),
-    CurrentLimit(f64),
 }
 
 /// The whitened sensitivities of the law's coefficients `keys` (parameter indices) at `fit`'s
@@ -217,6 +137,7 @@ fn law_columns(
         Shape::StribeckSpeed(w) => shapes.omega_s = w,
         Shape::Harmonic(h) => shapes.harmonic = h.k,
         Shape::CurrentLimit(i) => shapes.current_limit = i,
+        Shape::Spot(s) => (shapes.spot_angle, shapes.spot_width) = (s.angle, s.width),
     }
     let mut shaped = law.clone().with_active(active);
     shaped.shapes = shapes;
@@ -554,6 +475,7 @@ pub(super) fn select(
             omega_s: chosen.iter().find_map(|&j| columns[j].omega_s()),
             harmonic: chosen.iter().find_map(|&j| columns[j].harmonic()),
             current_limit: chosen.iter().find_map(|&j| columns[j].current_limit()),
+            spot: chosen.iter().find_map(|&j| columns[j].spot()),
             step: None,
             harmonic_price: chosen
                 .iter()

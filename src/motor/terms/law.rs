@@ -12,7 +12,7 @@
 
 use super::{
     Balance, Magnitudes, PRIOR_SHARE, PhysicsTerm, Sample, Site, TermParam, TermSetting, TermState,
-    positive_setting, real,
+    finite_setting, positive_setting, real,
 };
 use crate::motor::Scalar;
 use crate::motor::dictionary::{self, N_FUNCTIONS, ODE_BALANCES, Point, Shapes};
@@ -144,6 +144,7 @@ impl PhysicsTerm for Law {
         26 "U*cos(2*pi*f*t)" "N·m/V" "1" "S" "rad/(s·V)",
         27 "omega*sin(k*theta)" "N·m·s/rad" "V·s/rad" "A·s/rad" "1",
         28 "omega*cos(k*theta)" "N·m·s/rad" "V·s/rad" "A·s/rad" "1",
+        29 "omega*exp(-2*(1-cos(theta-theta_0))/w^2)" "N·m·s/rad" "V·s/rad" "A·s/rad" "1",
     );
     const SETTINGS: &'static [TermSetting] = &[
         TermSetting {
@@ -181,6 +182,20 @@ impl PhysicsTerm for Law {
             speed_share: None,
             choices: &[],
         },
+        TermSetting {
+            key: "theta_0",
+            unit: "rad",
+            default: 0.0,
+            speed_share: None,
+            choices: &[],
+        },
+        TermSetting {
+            key: "w",
+            unit: "rad",
+            default: 0.5,
+            speed_share: None,
+            choices: &[],
+        },
     ];
     const STATES: &'static [TermState] = &[
         TermState {
@@ -206,6 +221,8 @@ impl PhysicsTerm for Law {
                 frequency: positive_setting(Self::NAME, "f", s[2])?,
                 harmonic: positive_setting(Self::NAME, "k", s[3])?,
                 current_limit: positive_setting(Self::NAME, "I_lim", s[4])?,
+                spot_angle: finite_setting(Self::NAME, "theta_0", s[5])?,
+                spot_width: positive_setting(Self::NAME, "w", s[6])?,
             },
         })
     }
@@ -217,6 +234,8 @@ impl PhysicsTerm for Law {
             self.shapes.frequency,
             self.shapes.harmonic,
             self.shapes.current_limit,
+            self.shapes.spot_angle,
+            self.shapes.spot_width,
         ]
     }
 

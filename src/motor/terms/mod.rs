@@ -160,6 +160,15 @@ pub(crate) fn positive_setting(term: &str, key: &str, v: f64) -> Result<f64, Str
     }
 }
 
+/// Settings checked for a finite value (an angle, of either sign).
+pub(crate) fn finite_setting(term: &str, key: &str, v: f64) -> Result<f64, String> {
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(format!("{term}.{key} = {v} must be a finite number"))
+    }
+}
+
 /// A relative change of a constant (a factor 1 + k), dimensionless and of either sign.
 pub(crate) const fn relative_param(key: &'static str) -> TermParam {
     TermParam {

@@ -12,7 +12,7 @@ use super::terms::{exp_below_one, tanh};
 use super::{Magnitudes, Scalar};
 
 /// The functions, in the order of the law's parameters (within each balance).
-pub const FUNCTIONS: [&str; 29] = [
+pub const FUNCTIONS: [&str; 30] = [
     "omega",
     "omega*|omega|",
     "omega^3",
@@ -42,6 +42,7 @@ pub const FUNCTIONS: [&str; 29] = [
     "U*cos(2*pi*f*t)",
     "omega*sin(k*theta)",
     "omega*cos(k*theta)",
+    "omega*exp(-2*(1-cos(theta-theta_0))/w^2)",
 ];
 
 /// How many functions the dictionary holds.
@@ -129,6 +130,16 @@ pub const OMEGA_SIN_THETA: usize = 27;
 pub const OMEGA_COS_THETA: usize = 28;
 pub const READING_RIPPLE: [usize; 2] = [OMEGA_SIN_THETA, OMEGA_COS_THETA];
 
+/// The speed times a spot of the angle, what is read of ω over a narrow span of each
+/// revolution: an encoder with a damaged or missing line (the speed from its pulses reads low
+/// where the line should be), a tachogenerator's worn commutator segment. The spot is a bump of
+/// width w about the angle θ₀, exp(−2·(1 − cos(θ − θ₀))/w²): about exp(−((θ − θ₀)/w)²) near θ₀,
+/// smooth and periodic in θ where a wrapped Gaussian would jump at the far side. Its harmonics
+/// fall off slowly (some 1/w of them carry it), so a ripple of one k holds a narrow spot's
+/// power only in part, and a sum of harmonics pays ½·ln N for each: the spot pays for one
+/// coefficient and its search over θ₀ and w (`unexplained::spot`).
+pub const OMEGA_SPOT: usize = 29;
+
 /// Which of [`RIPPLES`] function `f` belongs to, if either (none: `f` is not a ripple of the
 /// balances).
 pub fn ripple_of(f: usize) -> Option<usize> {
@@ -191,7 +202,7 @@ pub fn offered_in(f: usize, b: usize) -> bool {
         OMEGA_HEAT | I_HEAT => false,
         U_CHARGE | CURRENT_LIMIT | U_SIN_FT | U_COS_FT => b == 1,
         THETA | I_SIN_THETA | I_COS_THETA => b == 0,
-        OMEGA_SIN_THETA | OMEGA_COS_THETA => b == 3,
+        OMEGA_SIN_THETA | OMEGA_COS_THETA | OMEGA_SPOT => b == 3,
         CONSTANT => b >= ODE_BALANCES,
         _ => true,
     }
@@ -203,7 +214,7 @@ pub fn state_of(function: usize) -> Option<usize> {
         CHARGE | U_CHARGE => Some(0),
         HEAT | OMEGA_HEAT | I_HEAT => Some(1),
         SIN_THETA | COS_THETA | THETA | I_SIN_THETA | I_COS_THETA | OMEGA_SIN_THETA
-        | OMEGA_COS_THETA => Some(2),
+        | OMEGA_COS_THETA | OMEGA_SPOT => Some(2),
         _ => None,
     }
 }
@@ -220,6 +231,30 @@ pub struct Shapes {
     pub harmonic: f64,
     /// The current limit I_lim [A] of `sign(I)*max(|I|-I_lim,0)`.
     pub current_limit: f64,
+    /// The spot's angle θ₀ and width w [rad] ([`OMEGA_SPOT`]).
+    pub spot_angle: f64,
+    pub spot_width: f64,
+}
+
+/// Where a spot of the angle is and how wide ([`OMEGA_SPOT`]), as a report states it.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Spot {
+    pub theta_0: f64,
+    pub w: f64,
+}
+
+impl Spot {
+    /// θ₀ taken into [0, 2π): the same spot whatever turn the search or a fit left it on.
+    pub fn new(theta_0: f64, w: f64) -> Self {
+        Self {
+            theta_0: theta_0.rem_euclid(TAU),
+            w,
+        }
+    }
+
+    pub fn of(s: &Shapes) -> Self {
+        Self::new(s.spot_angle, s.spot_width)
+    }
 }
 
 /// Where the functions are evaluated: the state, the input and the law's own states.
@@ -333,6 +368,11 @@ impl<'a, D: Scalar> At<'a, D> {
             U_COS_FT => x.voltage * self.phase().1,
             OMEGA_SIN_THETA => x.speed * self.angle().0,
             OMEGA_COS_THETA => x.speed * self.angle().1,
+            OMEGA_SPOT => {
+                let off = x.theta - s.spot_angle;
+                let w2 = s.spot_width * s.spot_width;
+                x.speed * exp_below_one((off.cos() - 1.0) * (2.0 / w2))
+            }
             _ => unreachable!("the dictionary has {N_FUNCTIONS} functions"),
         }
     }
@@ -342,7 +382,7 @@ impl<'a, D: Scalar> At<'a, D> {
 /// a tenth of its balance's scale divided by it.
 pub fn typical_size(f: usize, m: &Magnitudes) -> f64 {
     match f {
-        0 | OMEGA_SIN_THETA | OMEGA_COS_THETA => m.speed,
+        0 | OMEGA_SIN_THETA | OMEGA_COS_THETA | OMEGA_SPOT => m.speed,
         1 => m.speed * m.speed,
         2 => m.speed.powi(3),
         5 | 6 | 8 | I_SIN_THETA | I_COS_THETA => m.current,
@@ -412,188 +452,4 @@ pub fn pretty(name: &str) -> String {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// k periods per revolution: sin(k·θ) and cos(k·θ) at the harmonic the shapes hold.
-    #[test]
-    fn the_angle_functions_turn_k_times_per_revolution() {
-        let x = Point {
-            t: 0.0,
-            current: 1.0,
-            speed: 1.0,
-            voltage: 1.0,
-            charge: 0.0,
-            heat: 0.0,
-            theta: 0.3,
-        };
-        let shapes = |harmonic| Shapes {
-            omega_smooth: 1.0,
-            omega_s: 50.0,
-            frequency: 50.0,
-            harmonic,
-            current_limit: 100.0,
-        };
-        assert_eq!(value(SIN_THETA, &x, &shapes(1.0)), 0.3f64.sin());
-        // 6·0.3 is 1.8 to the last bit or two.
-        assert!((value(SIN_THETA, &x, &shapes(6.0)) - 1.8f64.sin()).abs() < 1e-12);
-        assert!((value(COS_THETA, &x, &shapes(6.0)) - 1.8f64.cos()).abs() < 1e-12);
-        assert_eq!(FUNCTIONS[SIN_THETA], "sin(k*theta)");
-        assert_eq!(FUNCTIONS[COS_THETA], "cos(k*theta)");
-    }
-
-    /// The current's ripple is the current times the angle's, at the same harmonic, and a torque's
-    /// alone: a torque constant that varies over a turn.
-    #[test]
-    fn the_current_s_ripple_is_the_current_times_the_angle_s_in_the_torque_balance() {
-        let x = Point {
-            t: 0.0,
-            current: -12.5,
-            speed: 1.0,
-            voltage: 1.0,
-            charge: 0.0,
-            heat: 0.0,
-            theta: 0.7,
-        };
-        let shapes = Shapes {
-            omega_smooth: 1.0,
-            omega_s: 50.0,
-            frequency: 50.0,
-            harmonic: 3.0,
-            current_limit: 100.0,
-        };
-        for (ripple, angle) in [(I_SIN_THETA, SIN_THETA), (I_COS_THETA, COS_THETA)] {
-            assert_eq!(
-                value(ripple, &x, &shapes),
-                -12.5 * value(angle, &x, &shapes)
-            );
-            assert_eq!(state_of(ripple), Some(2), "it needs θ integrated");
-            let offered: Vec<bool> = (0..BALANCES.len()).map(|b| offered_in(ripple, b)).collect();
-            assert_eq!(offered, [true, false, false, false]);
-        }
-        assert_eq!(FUNCTIONS[I_SIN_THETA], "I*sin(k*theta)");
-        assert_eq!(index_of("torque:I*cos(k*theta)"), Ok(I_COS_THETA));
-    }
-
-    /// The supply's ripple is the input times the periodic functions of time, at the same
-    /// frequency, and a voltage's alone: a share of what the drive applies.
-    #[test]
-    fn the_supply_s_ripple_is_the_input_times_the_periodic_functions_in_the_voltage_balance() {
-        let x = Point {
-            t: 0.0123,
-            current: 3.0,
-            speed: 1.0,
-            voltage: -8.0,
-            charge: 0.0,
-            heat: 0.0,
-            theta: 0.0,
-        };
-        let shapes = Shapes {
-            omega_smooth: 1.0,
-            omega_s: 50.0,
-            frequency: 74.8,
-            harmonic: 1.0,
-            current_limit: 100.0,
-        };
-        for (ripple, plain) in SUPPLY_RIPPLE.into_iter().zip(PERIODIC) {
-            assert_eq!(value(ripple, &x, &shapes), -8.0 * value(plain, &x, &shapes));
-            assert_eq!(state_of(ripple), None);
-            let offered: Vec<bool> = (0..BALANCES.len()).map(|b| offered_in(ripple, b)).collect();
-            assert_eq!(offered, [false, true, false, false]);
-        }
-        assert_eq!(FUNCTIONS[U_SIN_FT], "U*sin(2*pi*f*t)");
-        assert_eq!(
-            index_of("voltage:U*cos(2*pi*f*t)"),
-            Ok(N_FUNCTIONS + U_COS_FT)
-        );
-    }
-
-    /// The speed's ripple is the speed times the angle's, at the same harmonic, and what is
-    /// read of ω alone: a tachometer's ripple.
-    #[test]
-    fn the_speed_s_ripple_is_the_speed_times_the_angle_s_in_what_is_read_of_omega() {
-        let x = Point {
-            t: 0.0,
-            current: 3.0,
-            speed: 180.0,
-            voltage: 2.0,
-            charge: 0.0,
-            heat: 0.0,
-            theta: 40.3,
-        };
-        let shapes = Shapes {
-            omega_smooth: 1.0,
-            omega_s: 50.0,
-            frequency: 50.0,
-            harmonic: 2.0,
-            current_limit: 100.0,
-        };
-        for (ripple, angle) in READING_RIPPLE.into_iter().zip([SIN_THETA, COS_THETA]) {
-            assert_eq!(
-                value(ripple, &x, &shapes),
-                180.0 * value(angle, &x, &shapes)
-            );
-            assert_eq!(state_of(ripple), Some(2), "it needs θ integrated");
-            assert!(reads_harmonic(ripple) && ripple_of(ripple).is_none());
-            let offered: Vec<bool> = (0..BALANCES.len()).map(|b| offered_in(ripple, b)).collect();
-            assert_eq!(offered, [false, false, false, true]);
-        }
-        assert_eq!(
-            index_of("measurement:omega:omega*sin(k*theta)"),
-            Ok(3 * N_FUNCTIONS + OMEGA_SIN_THETA)
-        );
-    }
-
-    /// Where each function may enter a fingerprint: the angle in the torque balance only (a
-    /// spring's), the constant in what is read only (in a balance it is a library term's).
-    #[test]
-    fn the_angle_winds_up_a_torque_and_the_constant_offsets_a_reading() {
-        assert_eq!(FUNCTIONS[THETA], "theta");
-        assert_eq!(FUNCTIONS[CONSTANT], "1");
-        let offered = |f| -> Vec<bool> { (0..BALANCES.len()).map(|b| offered_in(f, b)).collect() };
-        assert_eq!(offered(THETA), [true, false, false, false]);
-        assert_eq!(offered(CONSTANT), [false, false, true, true]);
-        assert_eq!(
-            index_of("measurement:omega:1"),
-            Ok(3 * N_FUNCTIONS + CONSTANT)
-        );
-        assert_eq!(key(2 * N_FUNCTIONS + THETA), "measurement:I:theta");
-    }
-
-    /// The current beyond a limit: nothing below it, the excess with the current's sign above
-    /// it, and its derivative in the current (what the law's sensitivities carry) the sign of
-    /// I there and zero below — to the softplus's rounding, e^(−23) or less 23 widths (3% of
-    /// the limit each) away from the bend.
-    #[test]
-    fn the_current_beyond_a_limit_is_zero_below_it_and_the_signed_excess_above() {
-        use num_dual::Dual64;
-        let shapes = Shapes {
-            omega_smooth: 1.0,
-            omega_s: 50.0,
-            frequency: 50.0,
-            harmonic: 1.0,
-            current_limit: 200.0,
-        };
-        let at = |current: f64| {
-            let x = Point {
-                t: 0.0,
-                current: Dual64::new(current, 1.0),
-                speed: Dual64::from(100.0),
-                voltage: Dual64::from(24.0),
-                charge: Dual64::from(0.0),
-                heat: Dual64::from(0.0),
-                theta: Dual64::from(0.0),
-            };
-            let v = value(CURRENT_LIMIT, &x, &shapes);
-            (v.re, v.eps)
-        };
-        let near = |(v, d): (f64, f64), (value, slope): (f64, f64)| {
-            (v - value).abs() < 1e-5 && (d - slope).abs() < 1e-5
-        };
-        assert!(near(at(50.0), (0.0, 0.0)), "{:?}", at(50.0));
-        assert!(near(at(-60.0), (0.0, 0.0)), "{:?}", at(-60.0));
-        assert!(near(at(400.0), (200.0, 1.0)), "{:?}", at(400.0));
-        assert!(near(at(-450.0), (-250.0, 1.0)), "{:?}", at(-450.0));
-        assert_eq!(FUNCTIONS[CURRENT_LIMIT], "sign(I)*max(|I|-I_lim,0)");
-    }
-}
+mod tests;

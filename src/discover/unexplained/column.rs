@@ -1,0 +1,97 @@
+//! The columns a state fingerprint's selection is offered: a dictionary function and the shape
+//! it is evaluated at (the Stribeck speed, the angle's harmonic, the current limit, a spot of
+//! the angle), with what finding that shape cost.
+
+use crate::motor::dictionary::Spot;
+
+use super::spot::SpotShape;
+
+/// A column of the regression: a function (dictionary index) and the shape it has, the
+/// Stribeck speed, the angle's harmonic, the current limit or a spot of the angle.
+pub(super) struct Column {
+    pub function: usize,
+    pub shape: Shape,
+}
+
+impl Column {
+    pub fn new(function: usize, shape: Shape) -> Self {
+        Self { function, shape }
+    }
+
+    pub fn omega_s(&self) -> Option<f64> {
+        match self.shape {
+            Shape::StribeckSpeed(w) => Some(w),
+            _ => None,
+        }
+    }
+
+    pub fn harmonic(&self) -> Option<f64> {
+        match self.shape {
+            Shape::Harmonic(h) => Some(h.k),
+            _ => None,
+        }
+    }
+
+    pub fn current_limit(&self) -> Option<f64> {
+        match self.shape {
+            Shape::CurrentLimit(i) => Some(i),
+            _ => None,
+        }
+    }
+
+    pub fn spot(&self) -> Option<Spot> {
+        match self.shape {
+            Shape::Spot(s) => Some(Spot::new(s.angle, s.width)),
+            _ => None,
+        }
+    }
+
+    /// What a move taking it pays on top of its ½·ln N and the step's look-elsewhere, for a
+    /// shape found by a search of its own (an order between the grid's, `order`: ln G).
+    pub fn price(&self) -> f64 {
+        match self.shape {
+            Shape::Harmonic(h) => h.price,
+            Shape::Spot(s) => s.price,
+            _ => 0.0,
+        }
+    }
+
+    /// For such a shape, the half-width of its refinement through the ODE (`named`).
+    pub fn width(&self) -> f64 {
+        match self.shape {
+            Shape::Harmonic(h) => h.width,
+            _ => 0.0,
+        }
+    }
+}
+
+/// A harmonic k of the angle offered, with what a column at it pays for its search (the
+/// grid's nothing: their number is in each step's look-elsewhere; the order search's ln G)
+/// and the half-width of its refinement through the ODE (0: none).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Harmonic {
+    pub k: f64,
+    pub price: f64,
+    pub width: f64,
+}
+
+impl Harmonic {
+    pub fn on_grid(k: f64) -> Self {
+        Self {
+            k,
+            price: 0.0,
+            width: 0.0,
+        }
+    }
+}
+
+/// How a column (a block of them) shapes the law it is evaluated on.
+#[derive(Clone, Copy)]
+pub(super) enum Shape {
+    /// The model's law's shapes (or the dictionary's defaults).
+    Own,
+    StribeckSpeed(f64),
+    Harmonic(Harmonic),
+    CurrentLimit(f64),
+    Spot(SpotShape),
+}
