@@ -27,7 +27,7 @@
 //! `speed_window`, `sensor_dropout`, `shorted_turn`; a tenth, `magnet_pickup` (on slow
 //! records, `--volts 2`), `emi_bursts`, `supply_dips`, `seal_friction`, `sensor_hysteresis`;
 //! an eleventh, `sample_jitter`, `asymmetric_tacho`, `encoder_missing_line` (the last on slow
-//! records, `--volts 2`).
+//! records, `--volts 2`); a twelfth, `encoder_missing_pulse` (on slow records, `--volts 2`).
 //!
 //! cargo run --release --example beyond_library_cases -- [--out DIR] [--per-effect 3]
 //!     [--seed-base 510000] [--min-nats 20] [--max-nats 300] [--effects a,b,…] [--volts 24]
@@ -251,6 +251,12 @@ enum Effect {
     /// of each revolution, ω·(1 − ε·exp(−(wrap(θ + φ)/0.3)²)) (on slow records, `--volts 2`).
     /// `--effects encoder_missing_line`.
     EncoderMissingLine { eps: f64, phase: f64 },
+    /// An encoder counting pulses over a window whose count is short by one while a missing
+    /// pulse's gap is inside it: ω read low by ε over a span of `span` radians of each
+    /// revolution, with sharp edges, ω·(1 − ε·[|wrap(θ + φ)| < span/2]) (on slow records,
+    /// `--volts 2`). Made after the spot of the angle (session 28) to ask it of a shape and
+    /// widths it was not made with: a box, 0.2 to 1.2 rad wide. `--effects encoder_missing_pulse`.
+    EncoderMissingPulse { eps: f64, span: f64, phase: f64 },
 }
 
 /// Whether sample `k` is one the encoder miscounts, and the sign: splitmix64 of salt and k.
@@ -470,6 +476,11 @@ impl Effect {
                 eps: 0.01,
                 phase: rng.random_range(0.0..2.0 * PI),
             },
+            "encoder_missing_pulse" => Effect::EncoderMissingPulse {
+                eps: 0.01,
+                span: rng.random_range(0.2..1.2),
+                phase: rng.random_range(0.0..2.0 * PI),
+            },
             other => panic!("unknown effect {other}; known: {:?}", Effect::NAMES),
         }
     }
@@ -527,7 +538,9 @@ impl Effect {
             Effect::SealFriction { a } => a,
             Effect::SensorHysteresis { h } => h,
             Effect::SampleJitter { s, .. } => s,
-            Effect::AsymmetricTacho { eps } | Effect::EncoderMissingLine { eps, .. } => eps,
+            Effect::AsymmetricTacho { eps }
+            | Effect::EncoderMissingLine { eps, .. }
+            | Effect::EncoderMissingPulse { eps, .. } => eps,
         }
     }
 
@@ -583,7 +596,9 @@ impl Effect {
             Effect::SealFriction { a } => *a = s,
             Effect::SensorHysteresis { h } => *h = s,
             Effect::SampleJitter { s: jitter, .. } => *jitter = s,
-            Effect::AsymmetricTacho { eps } | Effect::EncoderMissingLine { eps, .. } => *eps = s,
+            Effect::AsymmetricTacho { eps }
+            | Effect::EncoderMissingLine { eps, .. }
+            | Effect::EncoderMissingPulse { eps, .. } => *eps = s,
         }
         e
     }
@@ -641,7 +656,9 @@ impl Effect {
             Effect::SensorHysteresis { .. } => 50.0,
             // A jitter of at most 0.2 ms; a gain's asymmetry or a line's dip of at most half.
             Effect::SampleJitter { .. } => 2e-4,
-            Effect::AsymmetricTacho { .. } | Effect::EncoderMissingLine { .. } => 0.5,
+            Effect::AsymmetricTacho { .. }
+            | Effect::EncoderMissingLine { .. }
+            | Effect::EncoderMissingPulse { .. } => 0.5,
             _ => 1.0,
         }
     }
@@ -829,7 +846,8 @@ fn rhs(
         Some(
             Effect::TachoRipple { .. }
             | Effect::MagnetPickup { .. }
-            | Effect::EncoderMissingLine { .. },
+            | Effect::EncoderMissingLine { .. }
+            | Effect::EncoderMissingPulse { .. },
         ) => dx[2] = w,
         Some(&Effect::SupplyDips { d, f, phase }) => {
             if t >= 0.0 && (f * t + phase).fract() < 0.3 {
@@ -922,6 +940,11 @@ fn measured(e: Option<&Effect>, x: &[f64; 4]) -> [f64; 2] {
         Some(&Effect::EncoderMissingLine { eps, phase }) => {
             let wrapped = (x[2] + phase + PI).rem_euclid(2.0 * PI) - PI;
             [x[0], x[1] * (1.0 - eps * (-(wrapped / 0.3).powi(2)).exp())]
+        }
+        Some(&Effect::EncoderMissingPulse { eps, span, phase }) => {
+            let wrapped = (x[2] + phase + PI).rem_euclid(2.0 * PI) - PI;
+            let short = if wrapped.abs() < span / 2.0 { eps } else { 0.0 };
+            [x[0], x[1] * (1.0 - short)]
         }
         _ => [x[0], x[1]],
     }
@@ -1196,6 +1219,8 @@ fn expected(e: &Effect, input_level: f64) -> String {
         // What is read of ω, in the angle, a narrow dip once per revolution: the kind, the
         // place and the angle are asked (its harmonics fall off slowly: k is not).
         Effect::EncoderMissingLine { .. } => r#"{"kind": "state", "balance": "measurement:omega", "functions": ["omega*sin(k*theta)", "omega*cos(k*theta)"]}"#.into(),
+        // The same place and variables, a box in the angle: the kind and the place are asked.
+        Effect::EncoderMissingPulse { .. } => r#"{"kind": "state", "balance": "measurement:omega"}"#.into(),
         // The flux's ripple in both balances (as flux_saturation's): the kind, the angle and
         // the order are asked.
         Effect::CommutatorRipple { k, .. } => format!(r#"{{"kind": "state", "functions": ["omega*sin(k*theta)", "omega*cos(k*theta)", "I*sin(k*theta)", "I*cos(k*theta)"], "k": {k}}}"#),
