@@ -638,3 +638,36 @@ fn an_encoder_s_damaged_line_is_discovered_as_a_spot_of_the_angle_in_what_is_rea
     assert!((0.15..=0.6).contains(&spot.w), "w {}", spot.w);
     assert!(d.unexplained.is_none(), "{:?}", d.unexplained);
 }
+
+/// A law that holds functions of two balances reports them all: on a pulse counter short by
+/// one over a box 0.4 rad wide (encoder_missing_pulse-850002 of `--effects
+/// encoder_missing_pulse --per-effect 8 --seed-base 850000 --volts 2`, ε 0.27) the law holds
+/// the spot in what is read of ω and, extended, a torque in cos(3·θ). Before `also`, the report
+/// named the torque alone (the balance listed first) and the spot, the law's larger part, was
+/// in the fit's parameters only.
+#[test]
+fn a_law_in_two_balances_reports_each_balance_and_its_functions() {
+    let (problem, _) = fixture("encoder_missing_pulse-850002");
+    let d = diagnose(&problem);
+    let law = d.discovered.expect("a law is discovered");
+    let mut parts = vec![(law.balance.clone(), law.functions.clone())];
+    parts.extend(
+        law.also
+            .iter()
+            .map(|b| (b.balance.clone(), b.functions.clone())),
+    );
+    assert!(parts.len() >= 2, "{}", law.equation);
+    let spot = parts
+        .iter()
+        .find(|(b, _)| b == "measurement:omega")
+        .expect("the spot's balance is reported");
+    assert_eq!(
+        spot.1[0].name, "omega*exp(-2*(1-cos(theta-theta_0))/w^2)",
+        "{}",
+        law.equation
+    );
+    assert!(spot.1[0].q975 < 0.0, "{}", law.equation);
+    // Every balance is in the equation, one after another.
+    assert_eq!(law.equation.split("; ").count(), parts.len());
+    assert!(law.equation.contains("measured ω +="), "{}", law.equation);
+}

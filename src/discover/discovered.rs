@@ -48,38 +48,65 @@ pub struct Discovered {
     /// The spot's θ₀ and w [rad] (`theta_0`, `w`), where the law holds a spot of the angle.
     #[serde(flatten, skip_serializing_if = "Option::is_none")]
     pub spot: Option<Spot>,
-    /// The law as the report prints it, e.g. `J dω/dt += −0.0001·sign(ω)·|I| [95%: …]`.
+    /// The law's functions in its other balances, where it holds more than one (a law
+    /// extended by a function of another balance): each balance with its functions.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub also: Vec<DiscoveredBalance>,
+    /// The law as the report prints it, e.g. `J dω/dt += −0.0001·sign(ω)·|I| [95%: …]`, each
+    /// further balance after a semicolon.
     pub equation: String,
 }
 
-/// The law `fit` holds, in the balance whose functions it lists first, with `gained` its
-/// score over the model before it; `None` when it holds none.
+/// A further balance of a discovered law and its functions.
+#[derive(Clone, Debug, Serialize)]
+pub struct DiscoveredBalance {
+    pub balance: String,
+    pub functions: Vec<DiscoveredFunction>,
+}
+
+/// The law `fit` holds, in the balance whose functions it lists first (the others in `also`),
+/// with `gained` its score over the model before it; `None` when it holds none.
 pub fn discovered(fit: &Candidate, gained: f64) -> Option<Discovered> {
     let law = fit.problem.model.terms.iter().find_map(|t| match &t.term {
         Term::Law(law) => Some(law),
         _ => None,
     })?;
-    let first = *law.active.first()?;
-    let balance = first / N_FUNCTIONS;
     let sds = fit.map.laplace_sd();
-    let mut functions = Vec::new();
-    for &k in law.active.iter().filter(|&&k| k / N_FUNCTIONS == balance) {
-        let name = format!("law.{}", dictionary::key(k));
-        let i = fit
-            .posterior
-            .calibrated()
-            .iter()
-            .position(|c| c.name == name)?;
-        let value = *fit.theta.get(&name)?;
-        let half = 1.96 * sds[i];
-        functions.push(DiscoveredFunction {
-            name: FUNCTIONS[k % N_FUNCTIONS].to_string(),
-            coefficient: value,
-            q025: value - half,
-            q975: value + half,
+    let mut balances: Vec<usize> = law.active.iter().map(|k| k / N_FUNCTIONS).collect();
+    balances.dedup();
+    let mut parts = Vec::new();
+    for &balance in &balances {
+        let mut functions = Vec::new();
+        for &k in law.active.iter().filter(|&&k| k / N_FUNCTIONS == balance) {
+            let name = format!("law.{}", dictionary::key(k));
+            let i = fit
+                .posterior
+                .calibrated()
+                .iter()
+                .position(|c| c.name == name)?;
+            let value = *fit.theta.get(&name)?;
+            let half = 1.96 * sds[i];
+            functions.push(DiscoveredFunction {
+                name: FUNCTIONS[k % N_FUNCTIONS].to_string(),
+                coefficient: value,
+                q025: value - half,
+                q975: value + half,
+            });
+        }
+        parts.push(DiscoveredBalance {
+            balance: BALANCES[balance].to_string(),
+            functions,
         });
     }
-    let holds = |f: usize| functions.iter().any(|g| g.name == FUNCTIONS[f]);
+    let mut parts = parts.into_iter();
+    let DiscoveredBalance { balance, functions } = parts.next()?;
+    let also: Vec<DiscoveredBalance> = parts.collect();
+    let holds = |f: usize| {
+        std::iter::once(&functions)
+            .chain(also.iter().map(|b| &b.functions))
+            .flatten()
+            .any(|g| g.name == FUNCTIONS[f])
+    };
     let omega_s = holds(STRIBECK).then_some(law.shapes.omega_s);
     let k = (0..N_FUNCTIONS)
         .any(|f| reads_harmonic(f) && holds(f))
@@ -96,8 +123,9 @@ pub fn discovered(fit: &Candidate, gained: f64) -> Option<Discovered> {
         k,
         current_limit,
         frequency_hz,
-        balance: BALANCES[balance].to_string(),
+        balance,
         functions,
+        also,
         score: gained,
     };
     law.write_equation();
@@ -106,20 +134,26 @@ pub fn discovered(fit: &Candidate, gained: f64) -> Option<Discovered> {
 
 impl Discovered {
     fn write_equation(&mut self) {
-        let terms: Vec<EquationTerm> = self
-            .functions
-            .iter()
-            .map(|f| (f.name.clone(), f.coefficient, Some((f.q025, f.q975))))
-            .collect();
-        self.equation = with_spot(
-            with_shapes(
-                equation_with(&self.balance, &terms),
-                self.k,
-                self.current_limit,
-                self.frequency_hz,
-            ),
-            self.spot,
-        );
+        let one = |balance: &str, functions: &[DiscoveredFunction]| {
+            let terms: Vec<EquationTerm> = functions
+                .iter()
+                .map(|f| (f.name.clone(), f.coefficient, Some((f.q025, f.q975))))
+                .collect();
+            with_spot(
+                with_shapes(
+                    equation_with(balance, &terms),
+                    self.k,
+                    self.current_limit,
+                    self.frequency_hz,
+                ),
+                self.spot,
+            )
+        };
+        let mut equation = one(&self.balance, &self.functions);
+        for b in &self.also {
+            equation = format!("{equation}; {}", one(&b.balance, &b.functions));
+        }
+        self.equation = equation;
     }
 
     /// The sampled fit's posterior mean and 95% interval in place of the Laplace ones, where
@@ -129,10 +163,14 @@ impl Discovered {
         mean: &BTreeMap<String, f64>,
         interval: &BTreeMap<String, [f64; 2]>,
     ) {
-        for f in &mut self.functions {
-            let name = format!("law.{}:{}", self.balance, f.name);
-            if let (Some(&m), Some(&[lo, hi])) = (mean.get(&name), interval.get(&name)) {
-                (f.coefficient, f.q025, f.q975) = (m, lo, hi);
+        let parts = std::iter::once((&self.balance, &mut self.functions))
+            .chain(self.also.iter_mut().map(|b| (&b.balance, &mut b.functions)));
+        for (balance, functions) in parts {
+            for f in functions {
+                let name = format!("law.{balance}:{}", f.name);
+                if let (Some(&m), Some(&[lo, hi])) = (mean.get(&name), interval.get(&name)) {
+                    (f.coefficient, f.q025, f.q975) = (m, lo, hi);
+                }
             }
         }
         self.write_equation();

@@ -72,7 +72,7 @@ pub use candidate::{Candidate, Confirmation, answer_params, fit_candidate, fit_c
 pub use coincide::{InputCoincidence, InputStep, input_steps};
 pub use confirm::importance_evidence;
 pub use diagnosis::{Diagnosis, PassedOver, RankEntry, StageFit};
-pub use discovered::{Discovered, DiscoveredFunction, discovered};
+pub use discovered::{Discovered, DiscoveredBalance, DiscoveredFunction, discovered};
 pub use fits::{FitSummary, Mismatch, SampledFit, Whiteness, ljung_box};
 pub use named::{NamedTerm, named_term, named_terms};
 pub use selection::{Selection, forward_selection, rank};
