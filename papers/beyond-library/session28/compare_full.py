@@ -6,7 +6,6 @@ whole-command reports compared field by field, times and paths aside.
     compare_full.py RUN_A RUN_B"""
 import json, os, sys
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "session12"))
 NEW = "omega*exp(-2*(1-cos(theta-theta_0))/w^2)"
 
 
@@ -17,12 +16,11 @@ def strip(report):
     return report
 
 
-a, b = sys.argv[1], sys.argv[2]
-from importlib import util
-spec = util.spec_from_file_location("cf", os.path.join(os.path.dirname(__file__), "..", "session12", "compare_full.py"))
-src = open(spec.origin).read().split("\na, b = sys.argv")[0]
+# session12's `diff`, its own code (the part before its command line).
 ns = {}
-exec(src, ns)
+exec(open(os.path.join(os.path.dirname(__file__), "..", "session12", "compare_full.py")).read()
+     .split("\na, b = sys.argv")[0], ns)
+a, b = sys.argv[1], sys.argv[2]
 same = differ = 0
 for name in sorted(os.listdir(a)):
     if not name.endswith(".json") or not os.path.exists(os.path.join(b, name)):

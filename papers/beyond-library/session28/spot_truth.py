@@ -30,9 +30,12 @@ for d in sorted(os.listdir(cases)):
     if theta is not None:
         near += abs(off) <= w / 2
         within_w += abs(off) <= w
-    f = (law.get("functions") or [{}])[0]
+    # The spot's function, in the law's first balance or in `also` (a law in two balances).
+    parts = [law] + law.get("also", []) if law else []
+    f = next((g for p in parts for g in p["functions"] if g["name"].startswith("omega*exp")),
+             (law.get("functions") or [{}])[0])
     coef = f"{f['coefficient']:.4f} [{f['q025']:.4f}, {f['q975']:.4f}]" if f else "—"
     given = f"{g['theta_0']:.3f}, {g['w']:.3f}" if "theta_0" in g else g.get("kind", "—")
-    print(f"| {d} | {eps:.3f} | {span} | {line:.3f} | {given} | {law.get('balance', '—')} | "
+    print(f"| {d} | {eps:.3f} | {span} | {line:.3f} | {given} | {' + '.join(p['balance'] for p in parts) or '—'} | "
           f"{'—' if theta is None else f'{off:+.3f}'} | {'—' if theta is None else f'{abs(off) / w:.2f}'} | {coef} |")
 print(f"\n{total} cases; a spot's θ₀ within w/2 of the line on {near}, within w on {within_w}")
