@@ -4,7 +4,10 @@ field, the times left out (runtime_s, ranking_s, selection_s, each fit's wall_s)
 written (outputs). Prints, per case, the fields that differ (a path into the JSON), then the
 counts.
 
-    compare_full.py RUN_A RUN_B"""
+    compare_full.py [--ignore-units-of FUNCTION] RUN_A RUN_B
+
+With --ignore-units-of, the `units` entries naming FUNCTION are left out too (a function new
+to the law's dictionary, which every report's `units` lists once it is there)."""
 import json, os, sys
 
 TIMES = {"runtime_s", "ranking_s", "selection_s", "wall_s", "outputs"}
@@ -31,16 +34,30 @@ def diff(x, y, path, out):
         out.append(path)
 
 
-a, b = sys.argv[1], sys.argv[2]
+args = sys.argv[1:]
+ignored = None
+if args[0] == "--ignore-units-of":
+    ignored, args = args[1], args[2:]
+a, b = args[0], args[1]
+
+
+def load(path):
+    report = json.load(open(path))
+    if ignored and isinstance(report.get("units"), dict):
+        report["units"] = {k: v for k, v in report["units"].items() if ignored not in k}
+    return report
+
+
 same = differ = 0
 for name in sorted(os.listdir(a)):
     if not name.endswith(".json") or not os.path.exists(os.path.join(b, name)):
         continue
     out = []
-    diff(json.load(open(os.path.join(a, name))), json.load(open(os.path.join(b, name))), "", out)
+    diff(load(os.path.join(a, name)), load(os.path.join(b, name)), "", out)
     if out:
         differ += 1
         print(f"{name[:-5]}: {', '.join(out[:8])}{' …' if len(out) > 8 else ''}")
     else:
         same += 1
-print(f"{same} reports the same (times and paths aside), {differ} differ")
+aside = f"times, paths and the units of {ignored}" if ignored else "times and paths"
+print(f"{same} reports the same ({aside} aside), {differ} differ")

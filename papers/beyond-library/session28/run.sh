@@ -9,7 +9,8 @@ HERE=papers/beyond-library/session28; B=papers/beyond-library; T=${T:-/tmp/s28/v
 #       --seed-base 850000 --volts 2
 #   library_residual $T/cases/h85v/*/ > $HERE/library-residual-850000.md
 for R in base new; do for f in $T/${R}2/*.json $T/${R}85/*.json; do ln -sf $f $T/$R/; done; done
-python3 $HERE/compare_full.py $T/base $T/new > $HERE/compare-full-base-new.txt || true
+python3 $B/session12/compare_full.py --ignore-units-of "omega*exp(-2*(1-cos(theta-theta_0))/w^2)" \
+    $T/base $T/new > $HERE/compare-full-base-new.txt || true
 python3 $B/session22/verdict_keys.py $T/base $T/new > $HERE/verdict-keys-base-new.txt || true
 # Each set's reports as REPORTS/CASE/report.json, as kind_table.py and rule_breaks.py read them.
 for R in base new; do for S in h77 h82 h82v h83 h83v h85v; do
