@@ -41,7 +41,7 @@ impl Column {
 
     pub fn spot(&self) -> Option<Spot> {
         match self.shape {
-            Shape::Spot(s) => Some(Spot::new(s.angle, s.width)),
+            Shape::Spot(s) => Some(s.spot),
             _ => None,
         }
     }

@@ -60,6 +60,11 @@ impl Context {
         self.n * self.channels.len()
     }
 
+    /// The record's mean sampling interval [s].
+    pub fn interval(&self) -> f64 {
+        (self.times[self.n - 1] - self.times[0]) / (self.n - 1).max(1) as f64
+    }
+
     /// The angle θ at the record's samples, the predicted speed's integral from t = 0 (as the
     /// law's own state is); none without a speed channel.
     pub fn angle(&self) -> Option<Vec<f64>> {

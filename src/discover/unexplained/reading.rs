@@ -6,7 +6,7 @@ use nalgebra::DMatrix;
 
 use crate::motor::Term;
 use crate::motor::dictionary::{
-    self, CONSTANT, CURRENT_LIMIT, N_FUNCTIONS, Point, READING_RIPPLE, RIPPLES, Shapes,
+    self, CONSTANT, CURRENT_LIMIT, N_FUNCTIONS, OMEGA_SPOT, Point, READING_RIPPLE, RIPPLES, Shapes,
 };
 
 use super::super::candidate::Candidate;
@@ -58,12 +58,14 @@ const SPEED: usize = 0;
 /// acting on the motor — the two told apart by ω, which the clip leaves alone. The speed is
 /// also offered times the angle's ripple at each of `harmonics` (θ the predicted speed's
 /// integral from the record's start, as the law's own state is), its sine and cosine one move
-/// as a balance's ripples are.
+/// as a balance's ripples are; and a spot of the angle on ω (`spot`), the record turning
+/// `per_sample` radians between samples at its speed scale.
 pub(super) fn fingerprints(
     fit: &Candidate,
     ctx: &Context,
     current_limits: &[f64],
     harmonics: &[Harmonic],
+    per_sample: f64,
     shift: f64,
 ) -> Vec<Evidence> {
     let model = fit.posterior.forward(0).model();
@@ -165,7 +167,19 @@ pub(super) fn fingerprints(
             |_: &Column| true,
         ));
     }
-    // And a spot of the angle on ω, a move of its own (its search paid by its price).
-    out.extend(super::spot::fingerprints(fit, ctx, shift));
+    // And a spot of the angle on ω, a move of its own (its search paid by its price), where
+    // the model's law holds none (a law has one θ₀ and w).
+    if let Some(c) = speed
+        && !held.iter().any(|k| k % N_FUNCTIONS == OMEGA_SPOT)
+    {
+        out.extend(super::spot::fingerprints(
+            ctx,
+            c,
+            &law.shapes,
+            &theta,
+            per_sample,
+            shift,
+        ));
+    }
     out
 }

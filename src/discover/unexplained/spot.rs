@@ -19,10 +19,8 @@ use std::f64::consts::PI;
 
 use nalgebra::DMatrix;
 
-use crate::motor::Term;
-use crate::motor::dictionary::{self, N_FUNCTIONS, OMEGA_SPOT, Point};
+use crate::motor::dictionary::{self, OMEGA_SPOT, Point, Shapes, Spot};
 
-use super::super::candidate::Candidate;
 use super::state::{Column, Shape, select};
 use super::{Context, Evidence};
 
@@ -30,17 +28,16 @@ use super::{Context, Evidence};
 const WIDEST: f64 = PI / 2.0;
 const HALVINGS: i32 = 4;
 
-/// A spot offered: its centre θ₀ and width w [rad], and what finding it cost (ln G).
+/// A spot offered, and what finding it cost (ln G).
 #[derive(Clone, Copy, Debug)]
 pub(super) struct SpotShape {
-    pub angle: f64,
-    pub width: f64,
+    pub spot: Spot,
     pub price: f64,
 }
 
 /// The grid of (θ₀, w) tried on a record whose speed scale turns `per_sample` radians between
 /// samples: widths from π/2 by halvings while at least `per_sample`, centres w/2 apart.
-pub(super) fn grid(per_sample: f64) -> Vec<(f64, f64)> {
+pub(super) fn grid(per_sample: f64) -> Vec<Spot> {
     let mut out = Vec::new();
     for j in 0..=HALVINGS {
         let width = WIDEST / 2f64.powi(j);
@@ -48,43 +45,28 @@ pub(super) fn grid(per_sample: f64) -> Vec<(f64, f64)> {
             break;
         }
         let centres = (4.0 * PI / width).round() as usize;
-        out.extend((0..centres).map(|i| (2.0 * PI * i as f64 / centres as f64, width)));
+        out.extend((0..centres).map(|i| Spot::new(2.0 * PI * i as f64 / centres as f64, width)));
     }
     out
 }
 
-/// The spot's fingerprint on what is read of ω, where the best spot of the grid clears the
-/// selection's bar; none where the model's own law holds a spot already (a law has one), or
-/// without a speed channel.
-pub(super) fn fingerprints(fit: &Candidate, ctx: &Context, shift: f64) -> Vec<Evidence> {
-    let model = fit.posterior.forward(0).model();
-    let Some(Term::Law(law)) = Term::named("law") else {
-        return Vec::new();
-    };
-    let Some(c) = ctx.channels.iter().position(|c| c == "omega") else {
-        return Vec::new();
-    };
-    let held = model.terms().iter().any(|t| match &t.term {
-        Term::Law(l) => l.active.iter().any(|k| k % N_FUNCTIONS == OMEGA_SPOT),
-        _ => false,
-    });
-    let Some(theta) = ctx.angle() else {
-        return Vec::new();
-    };
-    if held || ctx.n < 2 {
-        return Vec::new();
-    }
-    let interval = (ctx.times[ctx.n - 1] - ctx.times[0]) / (ctx.n - 1) as f64;
-    let speed = model.magnitudes(ctx.times[ctx.n - 1]).speed;
-    let shapes = grid(speed * interval);
-    if shapes.is_empty() {
-        return Vec::new();
-    }
-    let column = |angle: f64, width: f64| -> DMatrix<f64> {
-        let s = dictionary::Shapes {
-            spot_angle: angle,
-            spot_width: width,
-            ..law.shapes
+/// The spot's fingerprint on what is read of ω (channel `c`), where the best spot of the grid
+/// clears the selection's bar: the columns ω·spot(θ) at the predicted speed and angle `theta`,
+/// the law's other shapes `shapes`, on a record turning `per_sample` radians a sample.
+pub(super) fn fingerprints(
+    ctx: &Context,
+    c: usize,
+    shapes: &Shapes,
+    theta: &[f64],
+    per_sample: f64,
+    shift: f64,
+) -> Vec<Evidence> {
+    let spots = grid(per_sample);
+    let column = |spot: &Spot| -> DMatrix<f64> {
+        let s = Shapes {
+            spot_angle: spot.theta_0,
+            spot_width: spot.w,
+            ..*shapes
         };
         let mut b = DMatrix::zeros(ctx.m(), 1);
         for i in 0..ctx.n {
@@ -104,31 +86,30 @@ pub(super) fn fingerprints(fit: &Candidate, ctx: &Context, shift: f64) -> Vec<Ev
     };
     // The best single column by its gain ½·(b̃·y)²/(b̃·b̃); the first of equals, so the same
     // record gives the same spot.
-    let mut best: Option<(f64, f64, f64)> = None;
-    for &(angle, width) in &shapes {
-        let b = column(angle, width);
+    let mut best: Option<(f64, Spot, DMatrix<f64>)> = None;
+    for spot in &spots {
+        let b = column(spot);
         let bb = b.column(0).norm_squared();
         if bb <= 0.0 {
             continue;
         }
         let gain = 0.5 * b.column(0).dot(&ctx.y).powi(2) / bb;
-        if best.is_none_or(|(g, _, _)| gain > g) {
-            best = Some((gain, angle, width));
+        if best.as_ref().is_none_or(|(g, _, _)| gain > *g) {
+            best = Some((gain, *spot, b));
         }
     }
-    let Some((_, angle, width)) = best else {
+    let Some((_, spot, b_tilde)) = best else {
         return Vec::new();
     };
-    let spot = SpotShape {
-        angle,
-        width,
-        price: (shapes.len() as f64).ln(),
+    let shape = SpotShape {
+        spot,
+        price: (spots.len() as f64).ln(),
     };
-    let columns = [Column::new(OMEGA_SPOT, Shape::Spot(spot))];
+    let columns = [Column::new(OMEGA_SPOT, Shape::Spot(shape))];
     select(
         ctx,
         &columns,
-        &column(angle, width),
+        &b_tilde,
         "measurement:omega",
         shift,
         |_: &Column| true,
@@ -146,11 +127,11 @@ mod tests {
         // 0.19 rad a sample (a slow record): π/2 to π/16, 8 + 16 + 32 + 64 centres.
         let g = grid(0.19);
         assert_eq!(g.len(), 8 + 16 + 32 + 64);
-        let narrowest = g.iter().map(|s| s.1).fold(f64::INFINITY, f64::min);
+        let narrowest = g.iter().map(|s| s.w).fold(f64::INFINITY, f64::min);
         assert!((narrowest - PI / 16.0).abs() < 1e-12);
         // The paper's motor at 24 V turns 2.4 rad a sample: no spot is resolved.
         assert!(grid(2.4).is_empty());
         // Every centre lies in one turn.
-        assert!(g.iter().all(|&(a, _)| (0.0..2.0 * PI).contains(&a)));
+        assert!(g.iter().all(|s| (0.0..2.0 * PI).contains(&s.theta_0)));
     }
 }

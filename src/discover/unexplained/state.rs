@@ -137,7 +137,7 @@ fn law_columns(
         Shape::StribeckSpeed(w) => shapes.omega_s = w,
         Shape::Harmonic(h) => shapes.harmonic = h.k,
         Shape::CurrentLimit(i) => shapes.current_limit = i,
-        Shape::Spot(s) => (shapes.spot_angle, shapes.spot_width) = (s.angle, s.width),
+        Shape::Spot(s) => (shapes.spot_angle, shapes.spot_width) = (s.spot.theta_0, s.spot.w),
     }
     let mut shaped = law.clone().with_active(active);
     shaped.shapes = shapes;
@@ -217,7 +217,7 @@ pub(super) fn fingerprints(
             vec![Harmonic::on_grid(l.shapes.harmonic)]
         }
         _ => {
-            let interval = (ctx.times[ctx.n - 1] - ctx.times[0]) / (ctx.n - 1).max(1) as f64;
+            let interval = ctx.interval();
             let mut grid: Vec<Harmonic> = HARMONICS
                 .into_iter()
                 .filter(|&k| sampled_ripple(k, speed, interval))
@@ -362,6 +362,7 @@ pub(super) fn fingerprints(
         ctx,
         &current_limits,
         &harmonics,
+        speed * ctx.interval(),
         shift,
     ));
     Ok(out)
