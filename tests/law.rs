@@ -283,6 +283,30 @@ fn an_unknown_function_is_refused_naming_the_file_and_the_key() {
     }
 }
 
+/// A spot's shapes are checked as the law's other settings are: a width of zero (it divides
+/// by w²) or an angle that is no number is refused, naming the file, its line and the setting
+/// (the file's reader refuses a NaN before the term sees it).
+#[test]
+fn a_spot_without_a_width_or_an_angle_is_refused_naming_the_file_line_and_setting() {
+    let path = scratch("spot");
+    let spot = "\"measurement:omega:omega*exp(-2*(1-cos(theta-theta_0))/w^2)\" = -0.1";
+    for (setting, why) in [
+        ("w = 0.0", "law.w = 0 must be a positive number"),
+        ("theta_0 = nan", "law.theta_0 must be a finite number"),
+    ] {
+        std::fs::write(
+            &path,
+            format!("schema = 2\n[terms.law]\n{spot}\n{setting}\n"),
+        )
+        .unwrap();
+        let e = read_model_file(&path).unwrap_err().to_string();
+        assert!(
+            e.contains(&format!("{}:", path.display())) && e.contains(why),
+            "{setting}: {e}"
+        );
+    }
+}
+
 /// The dictionary at one point computes the factors its functions share once (sign(ω), the
 /// sine and cosine of kθ and of 2πft): whatever order a law asks them in, each function is
 /// its own formula, value and derivative, with the numbers num-dual's own sin, cos and exp

@@ -2,6 +2,19 @@
 
 use super::*;
 
+/// The law's default shapes (its settings' defaults), each test changing the ones it reads.
+fn shapes() -> Shapes {
+    Shapes {
+        omega_smooth: 1.0,
+        omega_s: 50.0,
+        frequency: 50.0,
+        harmonic: 1.0,
+        current_limit: 100.0,
+        spot_angle: 0.0,
+        spot_width: 0.5,
+    }
+}
+
 /// k periods per revolution: sin(k·θ) and cos(k·θ) at the harmonic the shapes hold.
 #[test]
 fn the_angle_functions_turn_k_times_per_revolution() {
@@ -15,13 +28,8 @@ fn the_angle_functions_turn_k_times_per_revolution() {
         theta: 0.3,
     };
     let shapes = |harmonic| Shapes {
-        omega_smooth: 1.0,
-        omega_s: 50.0,
-        frequency: 50.0,
         harmonic,
-        current_limit: 100.0,
-        spot_angle: 0.0,
-        spot_width: 0.5,
+        ..shapes()
     };
     assert_eq!(value(SIN_THETA, &x, &shapes(1.0)), 0.3f64.sin());
     // 6·0.3 is 1.8 to the last bit or two.
@@ -45,13 +53,8 @@ fn the_current_s_ripple_is_the_current_times_the_angle_s_in_the_torque_balance()
         theta: 0.7,
     };
     let shapes = Shapes {
-        omega_smooth: 1.0,
-        omega_s: 50.0,
-        frequency: 50.0,
         harmonic: 3.0,
-        current_limit: 100.0,
-        spot_angle: 0.0,
-        spot_width: 0.5,
+        ..shapes()
     };
     for (ripple, angle) in [(I_SIN_THETA, SIN_THETA), (I_COS_THETA, COS_THETA)] {
         assert_eq!(
@@ -80,13 +83,8 @@ fn the_supply_s_ripple_is_the_input_times_the_periodic_functions_in_the_voltage_
         theta: 0.0,
     };
     let shapes = Shapes {
-        omega_smooth: 1.0,
-        omega_s: 50.0,
         frequency: 74.8,
-        harmonic: 1.0,
-        current_limit: 100.0,
-        spot_angle: 0.0,
-        spot_width: 0.5,
+        ..shapes()
     };
     for (ripple, plain) in SUPPLY_RIPPLE.into_iter().zip(PERIODIC) {
         assert_eq!(value(ripple, &x, &shapes), -8.0 * value(plain, &x, &shapes));
@@ -115,13 +113,8 @@ fn the_speed_s_ripple_is_the_speed_times_the_angle_s_in_what_is_read_of_omega() 
         theta: 40.3,
     };
     let shapes = Shapes {
-        omega_smooth: 1.0,
-        omega_s: 50.0,
-        frequency: 50.0,
         harmonic: 2.0,
-        current_limit: 100.0,
-        spot_angle: 0.0,
-        spot_width: 0.5,
+        ..shapes()
     };
     for (ripple, angle) in READING_RIPPLE.into_iter().zip([SIN_THETA, COS_THETA]) {
         assert_eq!(
@@ -163,13 +156,8 @@ fn the_angle_winds_up_a_torque_and_the_constant_offsets_a_reading() {
 fn the_current_beyond_a_limit_is_zero_below_it_and_the_signed_excess_above() {
     use num_dual::Dual64;
     let shapes = Shapes {
-        omega_smooth: 1.0,
-        omega_s: 50.0,
-        frequency: 50.0,
-        harmonic: 1.0,
         current_limit: 200.0,
-        spot_angle: 0.0,
-        spot_width: 0.5,
+        ..shapes()
     };
     let at = |current: f64| {
         let x = Point {
@@ -199,13 +187,9 @@ fn the_current_beyond_a_limit_is_zero_below_it_and_the_signed_excess_above() {
 #[test]
 fn a_spot_of_the_angle_reads_the_speed_at_its_centre_once_per_revolution() {
     let shapes = Shapes {
-        omega_smooth: 1.0,
-        omega_s: 50.0,
-        frequency: 50.0,
-        harmonic: 1.0,
-        current_limit: 100.0,
         spot_angle: 2.0,
         spot_width: 0.2,
+        ..shapes()
     };
     let at = |theta: f64| Point {
         t: 0.0,
