@@ -29,7 +29,7 @@ use super::settings::{
 };
 use super::state::{StateFingerprint, fingerprint, reading};
 use super::ties::separating_input;
-use super::unexplained::{AsGiven, Unexplained, unexplained};
+use super::unexplained::{AsGiven, Unexplained, beyond_the_library, unexplained};
 
 #[derive(Clone, Debug, Serialize)]
 pub struct RankEntry {
@@ -214,6 +214,11 @@ pub fn assemble(
     } else {
         unexplained(problem, &none, &none, &as_given)?
     };
+    let library_best = (ranking.iter())
+        .filter(|c| c.added.len() == 1)
+        .max_by(|a, b| a.score.total_cmp(&b.score))
+        .map(|c| (c.added[0].as_str(), c.score - none.score));
+    let left_as_given = beyond_the_library(left_as_given, left.as_ref(), library_best);
     let mut ranking = ranking;
     let mut found = None;
     // A recording that cannot be this motor gets no physics named, by the library or the

@@ -13,7 +13,8 @@ use crate::error::Error;
 use crate::study::Problem;
 
 use super::super::candidate::Candidate;
-use super::{Context, Evidence, Fingerprint, Scores, oscillation, scores, state};
+use super::super::settings::EVIDENCE_THRESHOLD;
+use super::{Context, Evidence, Fingerprint, Scores, Unexplained, oscillation, scores, state};
 
 pub struct AsGiven {
     laws: Vec<Evidence>,
@@ -79,4 +80,48 @@ impl AsGiven {
     pub(super) fn scores(&self, shift: f64) -> Option<Scores> {
         self.scores.clone().map(|s| s.shifted(shift))
     }
+}
+
+/// The fingerprint of the model as given, of what it lacks beyond the library.
+///
+/// The verdict on the model as given leads with what explains most of its residual. Where that
+/// is a state or drift law and a single library term, fitted through the ODE on the same
+/// record, scores as much (within the threshold), the law is the library's term by another
+/// name: a supply dipping periodically loses on average a share of its voltage, which a law
+/// in ω and the term speed_gain hold alike, and the dips' frequency, which no term holds, is
+/// then hidden behind the law. What the model lacks beyond the library is what is left after
+/// the library's selection: that verdict's leader, where it has one, leads here, and the law
+/// heads the alternatives. Nothing else changes: the law is still offered to the fits
+/// (`AsGiven::fingerprints`), and the verdict after the selection is the report's own.
+/// `library_best` is the best single library term's score over the model as given (nats);
+/// `after` the verdict after the selection, before any law is taken.
+pub fn beyond_the_library(
+    as_given: Option<Unexplained>,
+    after: Option<&Unexplained>,
+    library_best: Option<(&str, f64)>,
+) -> Option<Unexplained> {
+    let mut verdict = as_given?;
+    let law = matches!(
+        verdict.fingerprint,
+        Fingerprint::State { .. } | Fingerprint::Drift { .. }
+    );
+    let (Some((term, best)), Some(after)) = (library_best, after) else {
+        return Some(verdict);
+    };
+    if !law || best < verdict.fingerprint.score() - EVIDENCE_THRESHOLD {
+        return Some(verdict);
+    }
+    let law = std::mem::replace(&mut verdict.fingerprint, after.fingerprint.clone());
+    verdict
+        .alternatives
+        .retain(|f| f.identity() != verdict.fingerprint.identity());
+    verdict.alternatives.insert(0, law.clone());
+    verdict.suggestion = format!(
+        "{}; on the model as given a law leads ({:+.1} nats), which the library's {term} holds \
+         as well ({best:+.1}): what is left beyond the library is named",
+        after.suggestion,
+        law.score()
+    );
+    verdict.figure = after.figure.clone();
+    Some(verdict)
 }

@@ -65,7 +65,7 @@ use crate::study::Problem;
 
 use super::candidate::Candidate;
 use super::settings::EVIDENCE_THRESHOLD;
-pub use as_given::AsGiven;
+pub use as_given::{AsGiven, beyond_the_library};
 pub use context::{Context, Scored};
 pub use figure::{FOLDED_BINS, Folded, UnexplainedFigure};
 pub use fingerprint::{
