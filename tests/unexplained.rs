@@ -559,3 +559,37 @@ fn a_lag_standing_in_for_a_jittered_clock_leaves_the_jitter_reported() {
         u.suggestion
     );
 }
+
+/// A supply that dips by a share d for 30% of each period 1/f (supply_dips-820010 of `--effects
+/// emi_bursts,supply_dips,seal_friction,sensor_hysteresis --per-effect 4 --seed-base 820000`:
+/// d 1%, f 28.7 Hz) loses on average 0.3·d of its voltage, which a law in ω and the library's
+/// speed_gain hold alike; the model as given's verdict led with that law and its fingerprint
+/// said "state", the dips' frequency hidden behind it. What the model lacks beyond the
+/// library is the periodic part: the fingerprint of the model as given is now the oscillation
+/// left after the library's selection, at the dips' frequency within 15%, running on whatever
+/// the input does, and the law heads its alternatives.
+#[test]
+fn a_supply_s_periodic_dips_are_named_by_their_frequency_beyond_the_term_that_holds_their_mean() {
+    let (problem, answer) = fixture("supply_dips-820010");
+    let f = truth_value(&answer, "f");
+    let d = whole_library(&problem);
+    let given = d
+        .unexplained_as_given
+        .expect("a 66-nat miss is not nothing");
+    match &given.fingerprint {
+        Fingerprint::Oscillation {
+            frequency_hz,
+            ringing,
+            ..
+        } => {
+            assert!(within(*frequency_hz, f, 0.15), "{frequency_hz} Hz vs {f}");
+            assert!(!ringing, "the dips run on");
+        }
+        other => panic!("{other:?}"),
+    }
+    assert!(
+        matches!(given.alternatives[0], Fingerprint::State { .. }),
+        "{:?}",
+        given.alternatives
+    );
+}

@@ -217,8 +217,8 @@ pub fn assemble(
     let library_best = (ranking.iter())
         .filter(|c| c.added.len() == 1)
         .max_by(|a, b| a.score.total_cmp(&b.score))
-        .map(|c| (c.added[0].as_str(), c.score - none.score));
-    let left_as_given = beyond_the_library(left_as_given, left.as_ref(), library_best);
+        .map(|c| (c.added[0].clone(), c.score - none.score));
+    let left_after_library = left.clone();
     let mut ranking = ranking;
     let mut found = None;
     // A recording that cannot be this motor gets no physics named, by the library or the
@@ -403,6 +403,13 @@ pub fn assemble(
             tie_experiments.insert(pair.join("/"), "reversal".into());
         }
     }
+    let law_alone = (selected_fit.added == ["law"]).then(|| selected_fit.score - none.score);
+    let left_as_given = beyond_the_library(
+        left_as_given,
+        left_after_library.as_ref(),
+        library_best.as_ref().map(|(t, s)| (t.as_str(), *s)),
+        law_alone,
+    );
     let mut diagnosis = Diagnosis {
         selected,
         selected_set: selected_set.clone(),

@@ -89,26 +89,38 @@ impl AsGiven {
 /// record, scores as much (within the threshold), the law is the library's term by another
 /// name: a supply dipping periodically loses on average a share of its voltage, which a law
 /// in ω and the term speed_gain hold alike, and the dips' frequency, which no term holds, is
-/// then hidden behind the law. What the model lacks beyond the library is what is left after
-/// the library's selection: that verdict's leader, where it has one, leads here, and the law
-/// heads the alternatives. Nothing else changes: the law is still offered to the fits
-/// (`AsGiven::fingerprints`), and the verdict after the selection is the report's own.
-/// `library_best` is the best single library term's score over the model as given (nats);
-/// `after` the verdict after the selection, before any law is taken.
+/// hidden behind the law. Where the verdict after the library's selection (`after`, before any
+/// law is taken) then leads with a kind no law is — an oscillation, a delay, a lag — that
+/// leads here, and the law heads the alternatives: what the model lacks beyond the library.
+/// Two exceptions, each for a reason: a law after the selection names nothing the law as given
+/// did not; and a law's score here is its first-order gain, which understates a large effect
+/// (its sensitivities are taken at zero coefficients), so where the law fitted through the ODE
+/// alone was selected (`law_alone`, its score over the model as given) and beats the library's
+/// best term by more than the threshold, the law is beyond the library and keeps its lead.
+/// Nothing else changes: the law is still offered to the fits (`AsGiven::fingerprints`), and
+/// the verdict after the selection is the report's own. `library_best` is the best single
+/// library term and its score over the model as given (nats).
 pub fn beyond_the_library(
     as_given: Option<Unexplained>,
     after: Option<&Unexplained>,
     library_best: Option<(&str, f64)>,
+    law_alone: Option<f64>,
 ) -> Option<Unexplained> {
     let mut verdict = as_given?;
-    let law = matches!(
-        verdict.fingerprint,
-        Fingerprint::State { .. } | Fingerprint::Drift { .. }
-    );
+    let is_law =
+        |f: &Fingerprint| matches!(f, Fingerprint::State { .. } | Fingerprint::Drift { .. });
+    let named = |f: &Fingerprint| {
+        matches!(
+            f,
+            Fingerprint::Oscillation { .. } | Fingerprint::Delay { .. } | Fingerprint::Lag { .. }
+        )
+    };
     let (Some((term, best)), Some(after)) = (library_best, after) else {
         return Some(verdict);
     };
-    if !law || best < verdict.fingerprint.score() - EVIDENCE_THRESHOLD {
+    let held = best >= verdict.fingerprint.score() - EVIDENCE_THRESHOLD
+        && law_alone.is_none_or(|law| law <= best + EVIDENCE_THRESHOLD);
+    if !is_law(&verdict.fingerprint) || !named(&after.fingerprint) || !held {
         return Some(verdict);
     }
     let law = std::mem::replace(&mut verdict.fingerprint, after.fingerprint.clone());
@@ -117,11 +129,147 @@ pub fn beyond_the_library(
         .retain(|f| f.identity() != verdict.fingerprint.identity());
     verdict.alternatives.insert(0, law.clone());
     verdict.suggestion = format!(
-        "{}; on the model as given a law leads ({:+.1} nats), which the library's {term} holds \
-         as well ({best:+.1}): what is left beyond the library is named",
+        "{}; on the model as given a law leads ({:+.1} nats), but the library's {term} holds as \
+         much ({best:+.1}): named here is what is left beyond the library",
         after.suggestion,
         law.score()
     );
     verdict.figure = after.figure.clone();
     Some(verdict)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::discover::unexplained::{LawFunction, UnexplainedFigure};
+
+    fn verdict(fingerprint: Fingerprint) -> Unexplained {
+        Unexplained {
+            evidence: fingerprint.score(),
+            channels: vec!["I".into(), "omega".into()],
+            spans: Vec::new(),
+            fingerprint: fingerprint.clone(),
+            alternatives: Vec::new(),
+            considered: vec![fingerprint],
+            suggestion: String::new(),
+            figure: UnexplainedFigure::default(),
+        }
+    }
+
+    fn law(score: f64) -> Fingerprint {
+        Fingerprint::State {
+            balance: "measurement:omega".into(),
+            functions: vec![LawFunction {
+                name: "omega*|omega|".into(),
+                coefficient: -1.2e-6,
+                sd: 1e-7,
+            }],
+            omega_s: None,
+            harmonic: None,
+            current_limit: None,
+            spot: None,
+            step: None,
+            harmonic_price: 0.0,
+            harmonic_width: 0.0,
+            score,
+        }
+    }
+
+    fn dips(score: f64) -> Fingerprint {
+        Fingerprint::Oscillation {
+            frequency_hz: 28.5,
+            frequency_sd: 0.1,
+            damping_ratio: None,
+            channel: "I".into(),
+            ringing: false,
+            sensor: false,
+            score,
+            frequencies: 100,
+        }
+    }
+
+    #[test]
+    fn a_law_a_library_term_holds_as_well_gives_the_lead_to_what_is_left_after_the_selection() {
+        let after = verdict(dips(23.3));
+        let given = beyond_the_library(
+            Some(verdict(law(62.3))),
+            Some(&after),
+            Some(("speed_gain", 61.0)),
+            None,
+        )
+        .expect("a verdict");
+        assert_eq!(given.fingerprint.identity(), "oscillation/I/false/false");
+        assert_eq!(given.alternatives[0].identity(), "state/measurement:omega");
+        assert_eq!(
+            given.evidence, 62.3,
+            "the evidence is still the model as given's"
+        );
+        assert!(
+            given.suggestion.contains("speed_gain"),
+            "{}",
+            given.suggestion
+        );
+    }
+
+    #[test]
+    fn a_law_no_library_term_holds_keeps_the_lead() {
+        // The best term short of the law by more than the threshold: the law is beyond it.
+        let after = verdict(dips(23.3));
+        let given = beyond_the_library(
+            Some(verdict(law(62.3))),
+            Some(&after),
+            Some(("speed_gain", 62.3 - EVIDENCE_THRESHOLD - 0.1)),
+            None,
+        )
+        .expect("a verdict");
+        assert_eq!(given.fingerprint.identity(), "state/measurement:omega");
+        assert!(given.alternatives.is_empty());
+    }
+
+    #[test]
+    fn with_nothing_left_after_the_selection_the_law_keeps_the_lead() {
+        let given = beyond_the_library(
+            Some(verdict(law(62.3))),
+            None,
+            Some(("speed_gain", 75.0)),
+            None,
+        )
+        .expect("a verdict");
+        assert_eq!(given.fingerprint.identity(), "state/measurement:omega");
+    }
+
+    #[test]
+    fn a_law_fitted_through_the_ode_beyond_the_library_keeps_the_lead() {
+        // Its first-order score within the threshold of the term's, its fit well above it.
+        let after = verdict(dips(23.3));
+        let given = beyond_the_library(
+            Some(verdict(law(62.3))),
+            Some(&after),
+            Some(("sensor_lag", 63.0)),
+            Some(63.0 + EVIDENCE_THRESHOLD + 0.1),
+        )
+        .expect("a verdict");
+        assert_eq!(given.fingerprint.identity(), "state/measurement:omega");
+    }
+
+    #[test]
+    fn only_a_law_gives_up_its_lead_and_only_to_a_kind_no_law_is() {
+        let best = Some(("speed_gain", 75.0));
+        let given = beyond_the_library(
+            Some(verdict(dips(30.0))),
+            Some(&verdict(law(10.0))),
+            best,
+            None,
+        )
+        .expect("a verdict");
+        assert_eq!(given.fingerprint.identity(), "oscillation/I/false/false");
+        let mut other = law(10.0);
+        if let Fingerprint::State { balance, .. } = &mut other {
+            *balance = "torque".into();
+        }
+        let given = beyond_the_library(Some(verdict(law(62.3))), Some(&verdict(other)), best, None)
+            .expect("a verdict");
+        assert_eq!(given.fingerprint.identity(), "state/measurement:omega");
+        assert!(beyond_the_library(None, Some(&verdict(dips(30.0))), best, None).is_none());
+    }
 }
