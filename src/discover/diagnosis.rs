@@ -403,7 +403,7 @@ pub fn assemble(
             tie_experiments.insert(pair.join("/"), "reversal".into());
         }
     }
-    let law_alone = (selected_fit.added == ["law"]).then(|| selected_fit.score - none.score);
+    let law_alone = (selected_fit.added == ["law"]).then_some(selected_fit.score - none.score);
     let left_as_given = beyond_the_library(
         left_as_given,
         left_after_library.as_ref(),
