@@ -30,22 +30,12 @@ const CRITICAL_DAMPING: f64 = 1.0;
 /// The speed's reading of the current, as the state fingerprint a law is named from, its
 /// coefficient started at zero.
 fn crosstalk() -> Fingerprint {
-    Fingerprint::State {
-        balance: "measurement:omega".into(),
-        functions: vec![LawFunction {
-            name: "I".into(),
-            coefficient: 0.0,
-            sd: 0.0,
-        }],
-        omega_s: None,
-        harmonic: None,
-        current_limit: None,
-        spot: None,
-        step: None,
-        harmonic_price: 0.0,
-        harmonic_width: 0.0,
-        score: 0.0,
-    }
+    let i = LawFunction {
+        name: "I".into(),
+        coefficient: 0.0,
+        sd: 0.0,
+    };
+    Fingerprint::plain_state("measurement:omega", vec![i], 0.0)
 }
 
 /// Where `selected` holds a coupling damped past critical: the law reading the current in the

@@ -157,22 +157,12 @@ mod tests {
     }
 
     fn law(score: f64) -> Fingerprint {
-        Fingerprint::State {
-            balance: "measurement:omega".into(),
-            functions: vec![LawFunction {
-                name: "omega*|omega|".into(),
-                coefficient: -1.2e-6,
-                sd: 1e-7,
-            }],
-            omega_s: None,
-            harmonic: None,
-            current_limit: None,
-            spot: None,
-            step: None,
-            harmonic_price: 0.0,
-            harmonic_width: 0.0,
-            score,
-        }
+        let f = LawFunction {
+            name: "omega*|omega|".into(),
+            coefficient: -1.2e-6,
+            sd: 1e-7,
+        };
+        Fingerprint::plain_state("measurement:omega", vec![f], score)
     }
 
     fn dips(score: f64) -> Fingerprint {

@@ -96,6 +96,23 @@ pub enum Fingerprint {
 }
 
 impl Fingerprint {
+    /// A state fingerprint of plain functions, no shape among them (no ω_s, k, I_lim, spot or
+    /// step).
+    pub fn plain_state(balance: &str, functions: Vec<LawFunction>, score: f64) -> Self {
+        Fingerprint::State {
+            balance: balance.into(),
+            functions,
+            omega_s: None,
+            harmonic: None,
+            current_limit: None,
+            spot: None,
+            step: None,
+            harmonic_price: 0.0,
+            harmonic_width: 0.0,
+            score,
+        }
+    }
+
     /// The same estimate scored `shift` nats lower (against a bar raised by `shift`).
     pub(super) fn shifted(mut self, shift: f64) -> Self {
         match &mut self {

@@ -313,13 +313,13 @@ pub fn unexplained(
             .filter(|g| g.kind.is_noise())
             .collect();
     }
-    let on_none = |g: &Generic| noise_on_none.iter().any(|n| std::ptr::eq(n, g));
-    let best_generic = (all.generic.iter())
-        .chain(&noise_on_none)
-        .max_by(|a, b| a.scored.score.total_cmp(&b.scored.score));
+    // The best generic alternative, and whether it was seen on the model as given.
+    let best_generic = (all.generic.iter().map(|g| (g, false)))
+        .chain(noise_on_none.iter().map(|g| (g, true)))
+        .max_by(|a, b| a.0.scored.score.total_cmp(&b.0.scored.score));
     let mut candidates: Vec<Evidence> = all.fingerprints;
-    if let Some(g) = best_generic {
-        let residual = match on_none(g) && !as_given.residual().is_empty() {
+    if let Some((g, on_none)) = best_generic {
+        let residual = match on_none && !as_given.residual().is_empty() {
             true => as_given.residual(),
             false => ctx.y.as_slice(),
         };
@@ -350,7 +350,7 @@ pub fn unexplained(
     let evidence = candidates
         .iter()
         .map(|e| e.fingerprint.score())
-        .chain(best_generic.map(|g| g.scored.score))
+        .chain(best_generic.map(|(g, _)| g.scored.score))
         .fold(f64::NEG_INFINITY, f64::max);
     if !(evidence > EVIDENCE_THRESHOLD) {
         return Ok(None);
@@ -410,10 +410,10 @@ pub fn unexplained(
         channels = ctx.channels.clone();
     }
     let mut suggestion = fingerprint.suggestion(&channels);
-    if let (Fingerprint::Unknown { .. }, Some(g)) = (&fingerprint, best_generic)
+    if let (Fingerprint::Unknown { .. }, Some((g, on_none))) = (&fingerprint, best_generic)
         && let Some((spans, sentence)) = g.reported(&ctx)
     {
-        suggestion = match on_none(g) {
+        suggestion = match on_none {
             true => format!(
                 "{sentence}; seen on the model as given, where it explains {:.1} nats more \
                  than the selected terms gained",
