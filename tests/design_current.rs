@@ -149,8 +149,9 @@ fn constant_current_record(model: &str, truth_terms: &str, times: &[f64]) -> Pro
     }
 }
 
-#[test]
-fn a_designed_current_separates_a_tie_better_than_the_fixed_experiments() {
+/// A quarter of a second at 400 Hz within `LIMITS`, and a small search (four segments, two
+/// starts, seed 3) with `draws` Monte Carlo draws for the reported gap.
+fn quarter_second_search(draws: usize) -> (Vec<f64>, Limits, DesignSettings) {
     let times = design_times(0.25, 400.0).unwrap();
     let limits: Limits = LIMITS.parse().unwrap();
     let settings = DesignSettings {
@@ -161,8 +162,14 @@ fn a_designed_current_separates_a_tie_better_than_the_fixed_experiments() {
             seed: 3,
         },
         limits,
-        draws: 4,
+        draws,
     };
+    (times, limits, settings)
+}
+
+#[test]
+fn a_designed_current_separates_a_tie_better_than_the_fixed_experiments() {
+    let (times, limits, settings) = quarter_second_search(4);
     let coulomb = "[terms.coulomb_friction]\nT_c = 0.02\n";
     // With d calibrated too, as HSM150's model calibrates it.
     let cases = [
@@ -437,18 +444,7 @@ fn on_a_drive_a_tie_no_experiment_parts_is_noted_with_the_drive_s_experiment() {
 /// of the distribution whose mean and sd the 20 records estimate.
 #[test]
 fn the_expected_gap_is_the_lead_a_record_shows_with_sigma_estimated() {
-    let times = design_times(0.25, 400.0).unwrap();
-    let limits: Limits = LIMITS.parse().unwrap();
-    let settings = DesignSettings {
-        search: SearchSettings {
-            segments: 4,
-            starts: 2,
-            iterations: 200,
-            seed: 3,
-        },
-        limits,
-        draws: 20,
-    };
+    let (times, limits, settings) = quarter_second_search(20);
     let model = model_text(false);
     let coulomb = "[terms.coulomb_friction]\nT_c = 0.02\n";
     let recorded = constant_current_record(&model, coulomb, &times);
