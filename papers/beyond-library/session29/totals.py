@@ -1,13 +1,16 @@
 #!/usr/bin/env python3
 """Totals of kind_table.py's tables over sets: `totals.py kind-tables-X.md` prints, per set
 and summed, the cases of the truth's kind outside the library (the cut: the library's best
-single term leaves >= 10 nats) and over all cases."""
+single term leaves >= 10 nats) and over all cases; and, on the blind sets, the misses at the cut by the as-given kind."""
 import re, sys
 
-rows, s = [], None
+rows, s, misses = [], None, {}
 for line in open(sys.argv[1]):
     if line.startswith("### "):
         s = line[4:].strip()
+    m = re.match(r"\| (\S+) \| (\S+) \| (\S+) \| ([\d.]+) \|", line)
+    if m and s >= "h78" and float(m[4]) >= 10:
+        misses.setdefault(m[3], []).append(m[1])
     m = re.match(r"all cases: (\d+) of (\d+)", line)
     if m:
         rows.append([s, int(m[1]), int(m[2]), 0, 0])
@@ -20,3 +23,5 @@ late = [r for r in rows if r[0] >= "h78"]
 for name, sel in (("sessions 19-28's blind sets (h78-h85v)", late), ("all sets", rows)):
     a, b, c, d = (sum(r[i] for r in sel) for i in (1, 2, 3, 4))
     print(f"{name}: all {a}/{b}, outside the library {c}/{d} ({100 * c / d:.0f}%)")
+print(f"blind misses at the cut by the model as given's kind: "
+      + "; ".join(f"{k} {len(v)} ({', '.join(v)})" for k, v in sorted(misses.items())))

@@ -91,7 +91,8 @@ impl AsGiven {
 /// in ω and the term speed_gain hold alike, and the dips' frequency, which no term holds, is
 /// hidden behind the law. Where the verdict after the library's selection (`after`, before any
 /// law is taken) then leads with a kind no law is — an oscillation, a delay, a lag — that
-/// leads here, and the law heads the alternatives: what the model lacks beyond the library.
+/// leads here, its figure with it, and the law heads the alternatives: what the model lacks
+/// beyond the library. The evidence stays the model as given's.
 /// Two exceptions, each for a reason: a law after the selection names nothing the law as given
 /// did not; and a law's score here is its first-order gain, which understates a large effect
 /// (its sensitivities are taken at zero coefficients), so where the law fitted through the ODE
