@@ -27,7 +27,8 @@
 //! `speed_window`, `sensor_dropout`, `shorted_turn`; a tenth, `magnet_pickup` (on slow
 //! records, `--volts 2`), `emi_bursts`, `supply_dips`, `seal_friction`, `sensor_hysteresis`;
 //! an eleventh, `sample_jitter`, `asymmetric_tacho`, `encoder_missing_line` (the last on slow
-//! records, `--volts 2`); a twelfth, `encoder_missing_pulse` (on slow records, `--volts 2`).
+//! records, `--volts 2`); a twelfth, `encoder_missing_pulse` (on slow records, `--volts 2`); a thirteenth (session 30),
+//! `dead_time`, `winding_heat`, `ac_coupled_tacho`, `loose_part`.
 //!
 //! cargo run --release --example beyond_library_cases -- [--out DIR] [--per-effect 3]
 //!     [--seed-base 510000] [--min-nats 20] [--max-nats 300] [--effects a,b,…] [--volts 24]
@@ -257,6 +258,20 @@ enum Effect {
     /// `--volts 2`). Made after the spot of the angle (session 28) to ask it of a shape and
     /// widths it was not made with: a box, 0.2 to 1.2 rad wide. `--effects encoder_missing_pulse`.
     EncoderMissingPulse { eps: f64, span: f64, phase: f64 },
+    /// The bridge's dead time (or the brushes' drop): the winding sees u_d less than the
+    /// input in the current's direction, U − u_d·tanh(I/1 A). `--effects dead_time`.
+    DeadTime { u_d: f64 },
+    /// The winding's resistance rising as it warms, R·(1 + α·T), its temperature a heat that
+    /// leaks away with time constant τ_th (0.2–2 s): dT/dt = R·I² − T/τ_th.
+    /// `--effects winding_heat`.
+    WindingHeat { alpha: f64, tau_th: f64 },
+    /// A tachometer read through a coupling capacitor: what is read of ω is ω less its own
+    /// low-pass of time constant τ (a first-order high-pass), τ ≥ 0.1 s.
+    /// `--effects ac_coupled_tacho`.
+    AcCoupledTacho { tau: f64 },
+    /// A loose part knocking on the shaft: torque pulses of a, 2 ms long, one at a random
+    /// instant in each 40-ms window, of random sign. `--effects loose_part`.
+    LoosePart { a: f64, salt: u64 },
 }
 
 /// Whether sample `k` is one the encoder miscounts, and the sign: splitmix64 of salt and k.
@@ -292,6 +307,14 @@ fn burst_sign(salt: u64, n: usize) -> f64 {
     } else {
         -1.0
     }
+}
+
+/// A uniform draw in [0, 1) for window `n`: splitmix64 of salt and n (the loose part's instant).
+fn salted_uniform(salt: u64, n: usize) -> f64 {
+    let mut z = salt ^ (n as u64 + 7).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
 }
 
 impl Effect {
@@ -481,6 +504,16 @@ impl Effect {
                 span: rng.random_range(0.2..1.2),
                 phase: rng.random_range(0.0..2.0 * PI),
             },
+            "dead_time" => Effect::DeadTime { u_d: 0.1 },
+            "winding_heat" => Effect::WindingHeat {
+                alpha: 1e-3,
+                tau_th: rng.random_range(0.2..2.0),
+            },
+            "ac_coupled_tacho" => Effect::AcCoupledTacho { tau: 1.0 },
+            "loose_part" => Effect::LoosePart {
+                a: 1e-3,
+                salt: rng.random(),
+            },
             other => panic!("unknown effect {other}; known: {:?}", Effect::NAMES),
         }
     }
@@ -541,6 +574,10 @@ impl Effect {
             Effect::AsymmetricTacho { eps }
             | Effect::EncoderMissingLine { eps, .. }
             | Effect::EncoderMissingPulse { eps, .. } => eps,
+            Effect::DeadTime { u_d } => u_d,
+            Effect::WindingHeat { alpha, .. } => alpha,
+            Effect::AcCoupledTacho { tau } => 1.0 / tau,
+            Effect::LoosePart { a, .. } => a,
         }
     }
 
@@ -599,6 +636,10 @@ impl Effect {
             Effect::AsymmetricTacho { eps }
             | Effect::EncoderMissingLine { eps, .. }
             | Effect::EncoderMissingPulse { eps, .. } => *eps = s,
+            Effect::DeadTime { u_d } => *u_d = s,
+            Effect::WindingHeat { alpha, .. } => *alpha = s,
+            Effect::AcCoupledTacho { tau } => *tau = 1.0 / s,
+            Effect::LoosePart { a, .. } => *a = s,
         }
         e
     }
@@ -659,6 +700,11 @@ impl Effect {
             Effect::AsymmetricTacho { .. }
             | Effect::EncoderMissingLine { .. }
             | Effect::EncoderMissingPulse { .. } => 0.5,
+            // A drop of at most 4 V; a coupling capacitor's time constant of at least 0.1 s;
+            // a knock of at most the torque of 100 A.
+            Effect::DeadTime { .. } => 4.0,
+            Effect::AcCoupledTacho { .. } => 10.0,
+            Effect::LoosePart { .. } => 1.0,
             _ => 1.0,
         }
     }
@@ -855,6 +901,22 @@ fn rhs(
             }
         }
         Some(&Effect::SealFriction { a }) => torque -= a * w.abs().sqrt() * w.tanh(),
+        Some(&Effect::DeadTime { u_d }) => u -= u_d * i.tanh(),
+        Some(&Effect::WindingHeat { alpha, tau_th }) => {
+            u -= m.r * alpha * x[2] * i;
+            dx[2] = m.r * i * i - x[2] / tau_th;
+        }
+        Some(&Effect::AcCoupledTacho { tau }) => dx[2] = (w - x[2]) / tau,
+        Some(&Effect::LoosePart { a, salt }) => {
+            let (window, width) = (0.04, 2e-3);
+            if t >= 0.0 {
+                let n = (t / window) as usize;
+                let start = n as f64 * window + 0.9 * window * salted_uniform(salt, n);
+                if t >= start && t < start + width {
+                    torque -= a * burst_sign(salt, n);
+                }
+            }
+        }
         // These act on what is measured (`measured`, `simulate`), not on the motor.
         Some(
             Effect::LeakageCurrent { .. }
@@ -937,6 +999,7 @@ fn measured(e: Option<&Effect>, x: &[f64; 4]) -> [f64; 2] {
         }
         Some(&Effect::MagnetPickup { a, phase }) => [x[0] + a * (x[2] + phase).sin(), x[1]],
         Some(&Effect::AsymmetricTacho { eps }) => [x[0], x[1] + eps * x[1].abs()],
+        Some(Effect::AcCoupledTacho { .. }) => [x[0], x[1] - x[2]],
         Some(&Effect::EncoderMissingLine { eps, phase }) => {
             let wrapped = (x[2] + phase + PI).rem_euclid(2.0 * PI) - PI;
             [x[0], x[1] * (1.0 - eps * (-(wrapped / 0.3).powi(2)).exp())]
@@ -1221,6 +1284,14 @@ fn expected(e: &Effect, input_level: f64) -> String {
         Effect::EncoderMissingLine { .. } => r#"{"kind": "state", "balance": "measurement:omega", "functions": ["omega*sin(k*theta)", "omega*cos(k*theta)"]}"#.into(),
         // The same place and variables, a box in the angle: the kind and the place are asked.
         Effect::EncoderMissingPulse { .. } => r#"{"kind": "state", "balance": "measurement:omega"}"#.into(),
+        // sign(I) is in no dictionary: the kind and the place are asked.
+        Effect::DeadTime { .. } => r#"{"kind": "state", "balance": "voltage"}"#.into(),
+        // A resistance that follows a leaky heat: a drift with the heat, as the magnet's.
+        Effect::WindingHeat { .. } => r#"{"kind": "drift", "variable": "heat", "balance": "voltage"}"#.into(),
+        // ω less its low-pass ≈ ω − θ/τ while t ≪ τ: what is read of ω, in the angle.
+        Effect::AcCoupledTacho { .. } => r#"{"kind": "state", "balance": "measurement:omega", "functions": ["theta"]}"#.into(),
+        // Knocks at random instants follow nothing of the motor: something is left on ω.
+        Effect::LoosePart { .. } => r#"{"kind": "unknown", "channel": "omega"}"#.into(),
         // The flux's ripple in both balances (as flux_saturation's): the kind, the angle and
         // the order are asked.
         Effect::CommutatorRipple { k, .. } => format!(r#"{{"kind": "state", "functions": ["omega*sin(k*theta)", "omega*cos(k*theta)", "I*sin(k*theta)", "I*cos(k*theta)"], "k": {k}}}"#),
