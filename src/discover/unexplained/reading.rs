@@ -7,6 +7,7 @@ use nalgebra::DMatrix;
 use crate::motor::Term;
 use crate::motor::dictionary::{
     self, CONSTANT, CURRENT_LIMIT, N_FUNCTIONS, OMEGA_SPOT, Point, READING_RIPPLE, RIPPLES, Shapes,
+    THETA,
 };
 
 use super::super::candidate::Candidate;
@@ -38,12 +39,19 @@ use super::{Context, Evidence};
 /// right order, the wrong place. Its moves (each of the pair alone, and the pair) raise the
 /// price of I's first column by the logarithm of how many more are tried: about half a nat
 /// on the six of session 20's 118 whose score it moved, and no selection or kind there.
-const MEASURED: [usize; 8] = [0, 1, 2, 5, 7, 9, 12, CONSTANT];
+///
+/// The speed's reading is offered the angle, θ = ∫ω: a speed read through a coupling
+/// capacitor (a first-order high-pass of time constant τ) reads ω less its own low-pass, about
+/// ω − θ/τ while t ≪ τ. It drifts with the angle turned, not with time, and the two part
+/// wherever the speed is not steady (the start, a reversal). Without it, such a reading was
+/// named a drift in time in the voltage balance. One column more on ω raises its first's price
+/// by ln(9/8), 0.12 nats.
+const MEASURED: [usize; 9] = [0, 1, 2, 5, 7, 9, 12, CONSTANT, THETA];
 /// The input, offered where it varies.
 const INPUT: usize = 9;
-/// Those of them that read the speed (`omega`, `omega*|omega|`, `omega^3`), and the current
-/// (`I`, `I*|I|`): offered only on that channel's own reading.
-const READS_SPEED: [usize; 3] = [0, 1, 2];
+/// Those of them that read the speed (`omega`, `omega*|omega|`, `omega^3`, `theta`), and the
+/// current (`I`, `I*|I|`): offered only on that channel's own reading.
+const READS_SPEED: [usize; 4] = [0, 1, 2, THETA];
 const READS_CURRENT: [usize; 2] = [5, 7];
 /// The speed itself read on the speed's channel: a gain, the library's `speed_gain`.
 const SPEED: usize = 0;

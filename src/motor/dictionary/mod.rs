@@ -191,9 +191,10 @@ pub fn reads_frequency(f: usize) -> bool {
 /// start-up, free to absorb whatever else a start-up leaves (on the slow cogging record 530007
 /// it extended the ripple's law by a hinge at 15 A, where the truth has none).
 ///
-/// The angle is offered in the torque balance only: a torque that winds up with the turn is a
-/// spring's; a voltage that does has no physics in a motor behind it (the angle's ripples,
-/// sin(k·θ) and cos(k·θ), are a commutator's in either). So is the current's ripple: a torque
+/// The angle is offered in the torque balance, where a torque that winds up with the turn is a
+/// spring's, and in what is read of ω, where a speed read through a coupling capacitor loses
+/// θ/τ (`unexplained::reading`); a voltage that winds up has no physics in a motor behind it
+/// (the angle's ripples, sin(k·θ) and cos(k·θ), are a commutator's in either). So is the current's ripple: a torque
 /// constant that varies with the angle (in the voltage balance its back-EMF would be ω's
 /// ripple, not I's). The supply's ripple is offered in the voltage balance only, where the
 /// supply acts. The speed's ripple is offered in what is read of ω only.
@@ -201,7 +202,8 @@ pub fn offered_in(f: usize, b: usize) -> bool {
     match f {
         OMEGA_HEAT | I_HEAT => false,
         U_CHARGE | CURRENT_LIMIT | U_SIN_FT | U_COS_FT => b == 1,
-        THETA | I_SIN_THETA | I_COS_THETA => b == 0,
+        THETA => b == 0 || b == 3,
+        I_SIN_THETA | I_COS_THETA => b == 0,
         OMEGA_SIN_THETA | OMEGA_COS_THETA | OMEGA_SPOT => b == 3,
         CONSTANT => b >= ODE_BALANCES,
         _ => true,

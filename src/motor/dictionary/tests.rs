@@ -132,14 +132,15 @@ fn the_speed_s_ripple_is_the_speed_times_the_angle_s_in_what_is_read_of_omega() 
     );
 }
 
-/// Where each function may enter a fingerprint: the angle in the torque balance only (a
-/// spring's), the constant in what is read only (in a balance it is a library term's).
+/// Where each function may enter a fingerprint: the angle in the torque balance (a spring's)
+/// and in what is read of ω (a coupling capacitor's loss), the constant in what is read only
+/// (in a balance it is a library term's).
 #[test]
-fn the_angle_winds_up_a_torque_and_the_constant_offsets_a_reading() {
+fn the_angle_winds_up_a_torque_or_a_speed_s_reading_and_the_constant_offsets_a_reading() {
     assert_eq!(FUNCTIONS[THETA], "theta");
     assert_eq!(FUNCTIONS[CONSTANT], "1");
     let offered = |f| -> Vec<bool> { (0..BALANCES.len()).map(|b| offered_in(f, b)).collect() };
-    assert_eq!(offered(THETA), [true, false, false, false]);
+    assert_eq!(offered(THETA), [true, false, false, true]);
     assert_eq!(offered(CONSTANT), [false, false, true, true]);
     assert_eq!(
         index_of("measurement:omega:1"),
