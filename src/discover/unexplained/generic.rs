@@ -1,7 +1,7 @@
 //! The generic alternatives' results, and what the report says where one of them leads.
 
 use super::spans::Span;
-use super::{Context, Scored, outliers, slope_noise};
+use super::{Context, Scored, knocks, outliers, slope_noise};
 
 /// A generic alternative's result on a channel.
 #[derive(Clone)]
@@ -36,6 +36,8 @@ pub(super) enum GenericKind {
         seconds: f64,
         channels: Vec<usize>,
     },
+    /// A torque at a few isolated instants (`knocks`): the instants [s].
+    Knocks(Vec<f64>),
 }
 
 impl GenericKind {
@@ -69,6 +71,10 @@ impl Generic {
             }
             GenericKind::SlopeNoise { seconds, channels } => {
                 let (spans, sentence) = slope_noise::reported(ctx, *seconds, channels);
+                Some((Some(spans), sentence))
+            }
+            GenericKind::Knocks(instants) => {
+                let (spans, sentence) = knocks::reported(ctx, self.channel, instants);
                 Some((Some(spans), sentence))
             }
             GenericKind::Lead => Some((

@@ -12,7 +12,8 @@
 //! of the model (its derivative with a lead's sign: generic, no sensor leads, but a balance
 //! whose fast dynamics the model has too slow looks so), isolated samples far off (a
 //! contaminated normal of one channel's residual, `outliers`), a noise whose spread follows the
-//! slope (the sampling instants' jitter, `slope_noise`), and the state fingerprints of the
+//! slope (the sampling instants' jitter, `slope_noise`), a torque at a few isolated instants
+//! (a part knocking, a coupling catching: `knocks`), and the state fingerprints of the
 //! balances and of what is read (`state`). Each is
 //! scored as the ranking scores a term: its linearised gain in log likelihood with the model's
 //! parameters refitted beside it (`regression`), less ½·ln N per degree of freedom, less the
@@ -39,6 +40,7 @@ mod context;
 mod figure;
 mod fingerprint;
 mod generic;
+mod knocks;
 mod order;
 mod oscillation;
 mod outliers;
@@ -229,6 +231,13 @@ fn scores(ctx: &Context, shift: f64) -> Scores {
         }
         // The lag's next model: a sensor that rings.
         fingerprints.extend(resonance::evidence(ctx, c, lag, shift));
+    }
+    if let Some(k) = knocks::evidence(ctx) {
+        generic.push(Generic {
+            channel: ctx.channels.iter().position(|c| c == "omega").unwrap_or(0),
+            kind: GenericKind::Knocks(k.instants),
+            scored: k.scored,
+        });
     }
     if let Some(j) = slope_noise::evidence(ctx) {
         generic.push(Generic {

@@ -1,0 +1,202 @@
+//! Knocks: a torque that acts at a few isolated instants and follows nothing (a loose part
+//! striking the shaft, a clutch or a dog coupling catching, a load that jolts).
+//!
+//! Such a torque is no function of the state or of time, so no law holds it, and it is not a
+//! reading's outlier either: it moves the motor, and the speed keeps the jolt, relaxing with
+//! the mechanical time constant, while the current answers through the back-EMF. Its image in
+//! the record is therefore known up to its size and its instant: the response of the model's
+//! linear balances (`torque_response`, at the fit's MAP) to a torque held over one sample
+//! interval, started at that instant. The alternative asked here is a few such images, chosen
+//! greedily (the one that gains most given those already chosen) and refitted together with
+//! the model's parameters, as every alternative of the verdict is.
+//!
+//! **The price**, fixed before any case was scored: each knock pays ½·ln N for its size, as
+//! every degree of freedom does, and the logarithm of how many instants it was chosen from,
+//! ln C(K, q) for q knocks among K candidate instants (the look-elsewhere price the isolated
+//! outliers pay, `outliers`). Under the model the best of K ≈ 500 one-column gains is about
+//! ½·(2·ln K − ln ln K) ≈ 5.3 nats, against a first knock's price of ½·ln 1002 + ln 500 ≈ 9.7:
+//! a false alarm needs a ½χ²₁ beyond 9.7 + 2 nats at one of 500 instants, about 500·P(χ²₁ >
+//! 23.4) ≈ 0.07% per record. The search stops at the first knock that does not pay its own
+//! price, or at [`MAX_KNOCKS`].
+//!
+//! Candidate instants leave out the samples just after each input step and the record's start
+//! (as the outliers do): there the model's fast dynamics decide the residual, and a friction's
+//! hump at start-up is a torque of a few samples that a law of the speed holds.
+
+use nalgebra::{DMatrix, DVector};
+
+use super::spans::Span;
+use super::timing::read_on_grid;
+use super::{Context, Scored};
+
+/// The most knocks one record is searched for: beyond a few dozen, what is left is a noise in
+/// the torque (the autoregression's), not isolated events.
+const MAX_KNOCKS: usize = 24;
+/// Samples after each input step (and the record's start) that are no candidate instant.
+const AFTER_STEP: usize = 3;
+
+/// The knocks found: their score and instants [s], in time order.
+pub(super) struct Knocks {
+    pub scored: Scored,
+    pub instants: Vec<f64>,
+}
+
+/// The whitened image, sample by sample from the knock's own, of a unit torque held over one
+/// sample interval, in each channel (stacked): none on a drive base, where the record has no
+/// current or speed channel, or where its samples are not evenly spaced (the image is then not
+/// one shape shifted).
+fn unit_image(ctx: &Context) -> Option<Vec<Vec<f64>>> {
+    let response = ctx.torque.as_ref()?;
+    let n = ctx.n;
+    let h = ctx.interval();
+    let even = ctx
+        .times
+        .windows(2)
+        .all(|w| ((w[1] - w[0]) - h).abs() <= 1e-6 * h);
+    if !even || !(h > 0.0) {
+        return None;
+    }
+    let step = ctx.fine.step();
+    let fine_n = ctx.fine.times.len();
+    // The torque on the fine grid from t = 0: one over the first interval, zero after.
+    let torque: Vec<f64> = (0..fine_n)
+        .map(|k| if (k as f64) * step < h - 0.5 * step { 1.0 } else { 0.0 })
+        .collect();
+    let states = response.respond(&torque);
+    let read = |c: &str| match c {
+        "I" => Some(0),
+        "omega" => Some(1),
+        _ => None,
+    };
+    let images: Vec<Vec<f64>> = ctx
+        .channels
+        .iter()
+        .enumerate()
+        .map(|(c, name)| match read(name) {
+            Some(s) => (0..n)
+                .map(|j| read_on_grid(&states[s], step, j as f64 * h) / ctx.sigma[c])
+                .collect(),
+            None => vec![0.0; n],
+        })
+        .collect();
+    images
+        .iter()
+        .any(|v| v.iter().any(|&x| x != 0.0))
+        .then_some(images)
+}
+
+/// The instants a knock may start at: every sample but the last and those just after a step.
+fn candidates(ctx: &Context) -> Vec<usize> {
+    let n = ctx.n;
+    (0..n - 1)
+        .filter(|&i| {
+            !ctx.steps.iter().any(|&s| {
+                let first = ctx.times.partition_point(|&u| u < s);
+                i >= first && i < first + AFTER_STEP
+            })
+        })
+        .collect()
+}
+
+/// The best set of knocks on the record, greedily; none where no knock pays its price.
+pub(super) fn evidence(ctx: &Context) -> Option<Knocks> {
+    let n = ctx.n;
+    if n < 20 {
+        return None;
+    }
+    let image = unit_image(ctx)?;
+    let at = candidates(ctx);
+    let k_all = at.len();
+    if k_all == 0 {
+        return None;
+    }
+    // Every candidate's column, residualized on the model's sensitivities.
+    let mut b = DMatrix::zeros(ctx.m(), k_all);
+    for (j, &start) in at.iter().enumerate() {
+        for (c, values) in image.iter().enumerate() {
+            for i in start..n {
+                b[(c * n + i, j)] = values[i - start];
+            }
+        }
+    }
+    let mut b = ctx.projector.residualize(&b);
+    let mut r: DVector<f64> = ctx.y_perp.clone();
+    let mut chosen: Vec<usize> = Vec::new();
+    while chosen.len() < MAX_KNOCKS.min(k_all) {
+        let q = chosen.len() + 1;
+        let price = 0.5 * ctx.ln_n + ((k_all - q + 1) as f64 / q as f64).ln();
+        let best = (0..k_all)
+            .filter(|j| !chosen.contains(j))
+            .map(|j| {
+                let col = b.column(j);
+                let norm = col.norm_squared();
+                let gain = if norm > 1e-12 {
+                    0.5 * col.dot(&r).powi(2) / norm
+                } else {
+                    0.0
+                };
+                (j, gain)
+            })
+            .max_by(|a, b| a.1.total_cmp(&b.1))?;
+        if best.1 <= price {
+            break;
+        }
+        chosen.push(best.0);
+        // The chosen column, normalised, taken out of the residual and of every other column.
+        let col = b.column(best.0).into_owned();
+        let unit = &col / col.norm();
+        r -= &unit * unit.dot(&r);
+        for j in 0..k_all {
+            let d = unit.dot(&b.column(j));
+            b.column_mut(j).axpy(-d, &unit, 1.0);
+        }
+    }
+    if chosen.is_empty() {
+        return None;
+    }
+    // The chosen knocks refitted together with the model's parameters, scored as every
+    // alternative is, the instants' price on top.
+    let q = chosen.len();
+    let mut columns = DMatrix::zeros(ctx.m(), q);
+    for (k, &j) in chosen.iter().enumerate() {
+        let start = at[j];
+        for (c, values) in image.iter().enumerate() {
+            for i in start..n {
+                columns[(c * n + i, k)] = values[i - start];
+            }
+        }
+    }
+    let location: f64 = (1..=q)
+        .map(|p| ((k_all - p + 1) as f64 / p as f64).ln())
+        .sum();
+    let scored = ctx.score(&columns, location);
+    let mut instants: Vec<f64> = chosen.iter().map(|&j| ctx.times[at[j]]).collect();
+    instants.sort_by(f64::total_cmp);
+    Some(Knocks { scored, instants })
+}
+
+/// The verdict's `where` and its sentence where knocks lead: each instant on the channel they
+/// are reported on (the speed's, which keeps the jolt).
+pub(super) fn reported(ctx: &Context, c: usize, instants: &[f64]) -> (Vec<Span>, String) {
+    let h = ctx.interval();
+    let spans = instants
+        .iter()
+        .map(|&t| Span {
+            channel: ctx.channels[c].clone(),
+            t_start: t,
+            t_end: t + h,
+        })
+        .collect();
+    let shown: Vec<String> = instants.iter().take(8).map(|t| format!("{t:.4}")).collect();
+    let more = if instants.len() > 8 { ", …" } else { "" };
+    let sentence = format!(
+        "the motor is jolted by a torque at {} isolated instant{} (t = {}{more} s) that \
+         follows nothing of the state: a loose part striking, a coupling or clutch catching, \
+         or a load that jerks, rather than a law; look for what happens at those instants, \
+         and record again with the load uncoupled to tell the motor from what it drives",
+        instants.len(),
+        if instants.len() == 1 { "" } else { "s" },
+        shown.join(", "),
+    );
+    (spans, sentence)
+}
