@@ -1,0 +1,28 @@
+#!/usr/bin/env python3
+"""Totals of kind_table.py's tables over sets (session 29's, with session 30's thirteenth set h90 on a line of its own): `totals.py kind-tables-X.md` prints, per set
+and summed, the cases of the truth's kind outside the library (the cut: the library's best
+single term leaves >= 10 nats) and over all cases; and, on the blind sets, the misses at the cut by the as-given kind."""
+import re, sys
+
+rows, s, misses = [], None, {}
+for line in open(sys.argv[1]):
+    if line.startswith("### "):
+        s = line[4:].strip()
+    m = re.match(r"\| (\S+) \| (\S+) \| (\S+) \| ([\d.]+) \|", line)
+    if m and "h78" <= s < "h9" and float(m[4]) >= 10:
+        misses.setdefault(m[3], []).append(m[1])
+    m = re.match(r"all cases: (\d+) of (\d+)", line)
+    if m:
+        rows.append([s, int(m[1]), int(m[2]), 0, 0])
+    m = re.match(r"outside the library .*\(the cut\): (\d+) of (\d+)", line)
+    if m:
+        rows[-1][3:] = [int(m[1]), int(m[2])]
+for r in rows:
+    print(f"{r[0]:6s} all {r[1]:3d}/{r[2]:<3d} outside {r[3]:3d}/{r[4]:<3d}")
+late = [r for r in rows if "h78" <= r[0] < "h9"]
+new = [r for r in rows if r[0] >= "h9"]
+for name, sel in (("sessions 19-28's blind sets (h78-h85v)", late), ("session 30's thirteenth set (h90)", new), ("all sets", rows)):
+    a, b, c, d = (sum(r[i] for r in sel) for i in (1, 2, 3, 4))
+    print(f"{name}: all {a}/{b}, outside the library {c}/{d} ({100 * c / d:.0f}%)")
+print(f"blind misses at the cut by the model as given's kind: "
+      + "; ".join(f"{k} {len(v)} ({', '.join(v)})" for k, v in sorted(misses.items())))
