@@ -32,7 +32,8 @@ use super::{Context, Scored};
 /// The most knocks one record is searched for: beyond a few dozen, what is left is a noise in
 /// the torque (the autoregression's), not isolated events.
 const MAX_KNOCKS: usize = 24;
-/// Samples after each input step (and the record's start) that are no candidate instant.
+/// The fewest samples after each input step (and the record's start) that are no candidate
+/// instant, where the model's mechanical time constant is shorter (as the outliers leave out).
 const AFTER_STEP: usize = 3;
 
 /// The knocks found: their score and instants [s], in time order.
