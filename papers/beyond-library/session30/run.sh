@@ -3,6 +3,8 @@
 # blind_sets.sh and session 27's validate.sh, and this session's h90), whole commands, two at
 # a time; a case already diagnosed into $T/NAME is skipped.
 #   run.sh BIN NAME   reports into $T/NAME/CASE.json, and a tree $T/tNAME/SET/CASE/report.json
+# (Session 29's run.sh quotes $2 inside its inner shell, so it wrote its reports into $T itself;
+# the first 74 of session 30's head reports were made so and moved into $T/head, the rest by this.)
 set -e
 T=${T:-/tmp/s30/b}; BIN=$1; NAME=$2; mkdir -p $T/$NAME
 export T BIN NAME
