@@ -36,8 +36,8 @@ pub(super) enum GenericKind {
         seconds: f64,
         channels: Vec<usize>,
     },
-    /// A torque at a few isolated instants (`knocks`): the instants [s].
-    Knocks(Vec<f64>),
+    /// A torque at a few isolated instants (`knocks`): the samples each starts at.
+    Knocks(Vec<usize>),
 }
 
 impl GenericKind {
@@ -73,8 +73,8 @@ impl Generic {
                 let (spans, sentence) = slope_noise::reported(ctx, *seconds, channels);
                 Some((Some(spans), sentence))
             }
-            GenericKind::Knocks(instants) => {
-                let (spans, sentence) = knocks::reported(ctx, self.channel, instants);
+            GenericKind::Knocks(starts) => {
+                let (spans, sentence) = knocks::reported(ctx, self.channel, starts);
                 Some((Some(spans), sentence))
             }
             GenericKind::Lead => Some((

@@ -25,7 +25,8 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::spans::Span;
+use super::order::read_of;
+use super::spans::{Span, at_samples, listed};
 use super::timing::read_on_grid;
 use super::{Context, Scored};
 
@@ -36,10 +37,18 @@ const MAX_KNOCKS: usize = 24;
 /// instant, where the model's mechanical time constant is shorter (as the outliers leave out).
 const AFTER_STEP: usize = 3;
 
-/// The knocks found: their score and instants [s], in time order.
+/// The knocks found: their score, the channel they are reported on (the speed's, which keeps
+/// the jolt), and the samples they start at, in time order.
 pub(super) struct Knocks {
     pub scored: Scored,
-    pub instants: Vec<f64>,
+    pub channel: usize,
+    pub starts: Vec<usize>,
+}
+
+/// What the q-th knock pays for where it is among `candidates` instants, beyond the q − 1
+/// before it: ln C(K, q) − ln C(K, q − 1).
+fn instant_price(candidates: usize, q: usize) -> f64 {
+    ((candidates - q + 1) as f64 / q as f64).ln()
 }
 
 /// The whitened image, sample by sample from the knock's own, of a unit torque held over one
@@ -70,16 +79,11 @@ fn unit_image(ctx: &Context) -> Option<Vec<Vec<f64>>> {
         })
         .collect();
     let states = response.respond(&torque);
-    let read = |c: &str| match c {
-        "I" => Some(0),
-        "omega" => Some(1),
-        _ => None,
-    };
     let images: Vec<Vec<f64>> = ctx
         .channels
         .iter()
         .enumerate()
-        .map(|(c, name)| match read(name) {
+        .map(|(c, name)| match read_of(name) {
             Some(s) => (0..n)
                 .map(|j| read_on_grid(&states[s], step, j as f64 * h) / ctx.sigma[c])
                 .collect(),
@@ -112,10 +116,14 @@ fn candidates(ctx: &Context, settle: usize) -> Vec<usize> {
         .collect()
 }
 
+fn speed_channel(ctx: &Context) -> Option<usize> {
+    ctx.channels.iter().position(|c| c == "omega")
+}
+
 /// The mechanical time constant as the model has it, in samples: how long the speed's image
 /// of a knock takes to fall to 1/e of its peak (none without a speed channel).
 fn settle(ctx: &Context, image: &[Vec<f64>]) -> usize {
-    let Some(speed) = ctx.channels.iter().position(|c| c == "omega") else {
+    let Some(speed) = speed_channel(ctx) else {
         return 0;
     };
     let v = &image[speed];
@@ -152,7 +160,7 @@ fn choose(mut b: DMatrix<f64>, mut r: DVector<f64>, ln_n: f64) -> Vec<usize> {
     let mut chosen: Vec<usize> = Vec::new();
     while chosen.len() < MAX_KNOCKS.min(k_all) {
         let q = chosen.len() + 1;
-        let price = 0.5 * ln_n + ((k_all - q + 1) as f64 / q as f64).ln();
+        let price = 0.5 * ln_n + instant_price(k_all, q);
         let Some(best) = (0..k_all)
             .filter(|j| !chosen.contains(j))
             .map(|j| {
@@ -208,39 +216,31 @@ pub(super) fn evidence(ctx: &Context) -> Option<Knocks> {
     let q = chosen.len();
     let starts: Vec<usize> = chosen.iter().map(|&j| at[j]).collect();
     let columns = images(ctx.m(), n, &image, &starts);
-    let location: f64 = (1..=q)
-        .map(|p| ((k_all - p + 1) as f64 / p as f64).ln())
-        .sum();
+    let location: f64 = (1..=q).map(|p| instant_price(k_all, p)).sum();
     let scored = ctx.score(&columns, location);
-    let mut instants: Vec<f64> = chosen.iter().map(|&j| ctx.times[at[j]]).collect();
-    instants.sort_by(f64::total_cmp);
-    Some(Knocks { scored, instants })
+    let mut starts = starts;
+    starts.sort_unstable();
+    Some(Knocks {
+        scored,
+        channel: speed_channel(ctx).unwrap_or(0),
+        starts,
+    })
 }
 
-/// The verdict's `where` and its sentence where knocks lead: each instant on the channel they
-/// are reported on (the speed's, which keeps the jolt).
-pub(super) fn reported(ctx: &Context, c: usize, instants: &[f64]) -> (Vec<Span>, String) {
-    let h = ctx.interval();
-    let spans = instants
-        .iter()
-        .map(|&t| Span {
-            channel: ctx.channels[c].clone(),
-            t_start: t,
-            t_end: t + h,
-        })
-        .collect();
-    let shown: Vec<String> = instants.iter().take(8).map(|t| format!("{t:.4}")).collect();
-    let more = if instants.len() > 8 { ", …" } else { "" };
+/// The verdict's `where` and its sentence where knocks lead: the instants each starts at, on
+/// channel `c`.
+pub(super) fn reported(ctx: &Context, c: usize, starts: &[usize]) -> (Vec<Span>, String) {
+    let instants: Vec<f64> = starts.iter().map(|&i| ctx.times[i]).collect();
     let sentence = format!(
-        "the motor is jolted by a torque at {} isolated instant{} (t = {}{more} s) that \
-         follows nothing of the state: a loose part striking, a coupling or clutch catching, \
-         or a load that jerks, rather than a law; look for what happens at those instants, \
-         and record again with the load uncoupled to tell the motor from what it drives",
+        "the motor is jolted by a torque at {} isolated instant{} (t = {} s) that follows \
+         nothing of the state: a loose part striking, a coupling or clutch catching, or a load \
+         that jerks, rather than a law; look for what happens at those instants, and record \
+         again with the load uncoupled to tell the motor from what it drives",
         instants.len(),
         if instants.len() == 1 { "" } else { "s" },
-        shown.join(", "),
+        listed(&instants),
     );
-    (spans, sentence)
+    (at_samples(ctx, c, starts), sentence)
 }
 
 #[cfg(test)]

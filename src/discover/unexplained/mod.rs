@@ -234,8 +234,8 @@ fn scores(ctx: &Context, shift: f64) -> Scores {
     }
     if let Some(k) = knocks::evidence(ctx) {
         generic.push(Generic {
-            channel: ctx.channels.iter().position(|c| c == "omega").unwrap_or(0),
-            kind: GenericKind::Knocks(k.instants),
+            channel: k.channel,
+            kind: GenericKind::Knocks(k.starts),
             scored: k.scored,
         });
     }

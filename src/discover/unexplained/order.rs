@@ -75,7 +75,7 @@ pub(super) fn search(ctx: &Context, k_max: f64) -> Option<Order> {
 }
 
 /// Which of the balances' states a channel reads: the current (0), the speed (1), or neither.
-fn read_of(channel: &str) -> Option<usize> {
+pub(super) fn read_of(channel: &str) -> Option<usize> {
     match channel {
         "I" => Some(0),
         "omega" => Some(1),

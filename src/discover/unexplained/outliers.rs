@@ -35,6 +35,7 @@ use nalgebra::DVector;
 
 use super::generic::GenericKind;
 use super::regression::Explained;
+use super::spans::{at_samples, listed};
 use super::{Context, Scored, Span};
 
 /// The largest share of samples that are outliers: beyond it the residual is a wider noise, or
@@ -187,22 +188,13 @@ pub(super) fn evidence(ctx: &Context, c: usize) -> Option<Outliers> {
     })
 }
 
-/// The verdict's `where`: the samples themselves, each a span of one instant on channel `c`.
-fn spans(ctx: &Context, c: usize, samples: &[usize]) -> Vec<Span> {
-    samples
-        .iter()
-        .map(|&i| Span {
-            channel: ctx.channels[c].clone(),
-            t_start: ctx.times[i],
-            t_end: ctx.times[i],
-        })
-        .collect()
-}
-
 /// The verdict's `where` and its sentence where isolated outliers on channel `c` lead.
 pub(super) fn reported(ctx: &Context, c: usize, samples: &[usize]) -> (Vec<Span>, String) {
     let at: Vec<f64> = samples.iter().map(|&i| ctx.times[i]).collect();
-    (spans(ctx, c, samples), suggestion(&ctx.channels[c], &at))
+    (
+        at_samples(ctx, c, samples),
+        suggestion(&ctx.channels[c], &at),
+    )
 }
 
 /// The verdict's `where` and its sentence where a noise of two scales on channel `c` leads: a
@@ -228,21 +220,19 @@ pub(super) fn tails_reported(
             ""
         },
     );
-    (spans(ctx, c, samples), sentence)
+    (at_samples(ctx, c, samples), sentence)
 }
 
 /// The sentence: how many, where, and what to do.
 fn suggestion(channel: &str, times: &[f64]) -> String {
-    let shown: Vec<String> = times.iter().take(8).map(|t| format!("{t:.4}")).collect();
-    let more = if times.len() > 8 { ", …" } else { "" };
     format!(
-        "{channel} has {} isolated sample{} far off the model that follow{} nothing (t = {}{more} \
+        "{channel} has {} isolated sample{} far off the model that follow{} nothing (t = {} \
          s): a sensor's miscount or a spike on its line rather than the motor's physics; look \
          at those samples in the recording, and drop or repair them before calibrating",
         times.len(),
         if times.len() == 1 { "" } else { "s" },
         if times.len() == 1 { "s" } else { "" },
-        shown.join(", ")
+        listed(times)
     )
 }
 

@@ -56,3 +56,23 @@ pub(super) fn runs(
     }
     out
 }
+
+/// The report's `where` for isolated samples of channel c (an outlier's, a knock's start): one
+/// instant each.
+pub(super) fn at_samples(ctx: &Context, c: usize, samples: &[usize]) -> Vec<Span> {
+    samples
+        .iter()
+        .map(|&i| Span {
+            channel: ctx.channels[c].clone(),
+            t_start: ctx.times[i],
+            t_end: ctx.times[i],
+        })
+        .collect()
+}
+
+/// Instants [s] as a sentence lists them: the first eight, then an ellipsis.
+pub(super) fn listed(times: &[f64]) -> String {
+    let shown: Vec<String> = times.iter().take(8).map(|t| format!("{t:.4}")).collect();
+    let more = if times.len() > 8 { ", …" } else { "" };
+    format!("{}{more}", shown.join(", "))
+}
