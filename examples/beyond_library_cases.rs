@@ -274,12 +274,16 @@ enum Effect {
     LoosePart { a: f64, salt: u64 },
 }
 
-/// Whether sample `k` is one the encoder miscounts, and the sign: splitmix64 of salt and k.
-fn glitch(salt: u64, k: usize) -> Option<f64> {
-    let mut z = salt ^ (k as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+/// splitmix64's finalizer: the draws below of a case's salt and a sample's or a window's index.
+fn mix(mut z: u64) -> u64 {
     z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^= z >> 31;
+    z ^ (z >> 31)
+}
+
+/// Whether sample `k` is one the encoder miscounts, and the sign: splitmix64 of salt and k.
+fn glitch(salt: u64, k: usize) -> Option<f64> {
+    let z = mix(salt ^ (k as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
     z.is_multiple_of(100)
         .then(|| if (z >> 40) & 1 == 1 { 1.0 } else { -1.0 })
 }
@@ -288,10 +292,8 @@ fn glitch(salt: u64, k: usize) -> Option<f64> {
 /// k, so that the jitter is a function of the case's draw alone.
 fn jitter_normal(salt: u64, k: usize) -> f64 {
     let uniform = |j: u64| {
-        let mut z = salt ^ (2 * k as u64 + j + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15);
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+        let z = mix(salt ^ (2 * k as u64 + j + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15));
+        (z >> 11) as f64 / (1u64 << 53) as f64
     };
     let (u1, u2) = (uniform(0).max(1e-300), uniform(1));
     (-2.0 * u1.ln()).sqrt() * (2.0 * PI * u2).cos()
@@ -299,10 +301,7 @@ fn jitter_normal(salt: u64, k: usize) -> f64 {
 
 /// The sign of the EMI burst `n`: a bit of splitmix64 of salt and n.
 fn burst_sign(salt: u64, n: usize) -> f64 {
-    let mut z = salt.wrapping_add((n as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15));
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    if (z ^ (z >> 31)) >> 63 == 1 {
+    if mix(salt.wrapping_add((n as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15))) >> 63 == 1 {
         1.0
     } else {
         -1.0
@@ -311,10 +310,8 @@ fn burst_sign(salt: u64, n: usize) -> f64 {
 
 /// A uniform draw in [0, 1) for window `n`: splitmix64 of salt and n (the loose part's instant).
 fn salted_uniform(salt: u64, n: usize) -> f64 {
-    let mut z = salt ^ (n as u64 + 7).wrapping_mul(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    (mix(salt ^ (n as u64 + 7).wrapping_mul(0x9E37_79B9_7F4A_7C15)) >> 11) as f64
+        / (1u64 << 53) as f64
 }
 
 impl Effect {
