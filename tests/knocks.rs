@@ -4,20 +4,23 @@
 
 mod beyond;
 
-use beyond::{fixture, truth_integer, truth_value};
-use motorcal::discover::{Diagnosis, DiscoverSettings, Fingerprint, discover};
-use motorcal::study::Problem;
+use beyond::{fixture, truth_integer, truth_value, whole_library};
+use motorcal::discover::{Fingerprint, Span};
 
-/// The diagnosis with the whole library, ranked only (the model as given's fingerprint is
-/// made before any fit is sampled).
-fn whole_library(problem: &Problem) -> Diagnosis {
-    let mut settings = DiscoverSettings {
-        rank_only: true,
-        candidates: None,
-        ..DiscoverSettings::default()
-    };
-    settings.run.quiet = true;
-    discover(problem, &settings).unwrap()
+/// The knocks the model as given's fingerprint names on case `name` (their `where`), after
+/// asserting that it names them: `unknown`, its sentence a jolt. The case's answer beside.
+fn knocks_named(name: &str, miss: &str) -> (Vec<Span>, serde_json::Value) {
+    let (problem, answer) = fixture(name);
+    let given = whole_library(&problem)
+        .unexplained_as_given
+        .unwrap_or_else(|| panic!("a {miss} miss is not nothing"));
+    assert!(
+        matches!(given.fingerprint, Fingerprint::Unknown { .. }),
+        "{:?}",
+        given.fingerprint
+    );
+    assert!(given.suggestion.contains("jolted"), "{}", given.suggestion);
+    (given.spans, answer)
 }
 
 /// A clutch engaging at t_e drags a second mass up to speed through a slipping plate for about
@@ -26,24 +29,13 @@ fn whole_library(problem: &Problem) -> Diagnosis {
 /// that a torque jolted the motor, and where: within 15 ms after the engagement.
 #[test]
 fn a_clutch_catching_is_named_a_knock_at_its_instant() {
-    let (problem, answer) = fixture("clutch_engagement-780012");
+    let (knocks, answer) = knocks_named("clutch_engagement-780012", "33-nat");
     let t_e = truth_value(&answer, "t_e");
-    let given = whole_library(&problem)
-        .unexplained_as_given
-        .expect("a 33-nat miss is not nothing");
     assert!(
-        matches!(given.fingerprint, Fingerprint::Unknown { .. }),
-        "{:?}",
-        given.fingerprint
-    );
-    assert!(given.suggestion.contains("jolted"), "{}", given.suggestion);
-    assert!(
-        given
-            .spans
+        knocks
             .iter()
             .any(|s| s.t_start >= t_e && s.t_start <= t_e + 0.015),
-        "engaged at {t_e}; knocks at {:?}",
-        given.spans
+        "engaged at {t_e}; knocks at {knocks:?}"
     );
 }
 
@@ -63,19 +55,10 @@ fn knock_instant(salt: u64, n: usize) -> f64 {
 /// 5 ms of a true one.
 #[test]
 fn a_loose_part_s_knocks_are_found_at_their_instants() {
-    let (problem, answer) = fixture("loose_part-900004");
+    let (knocks, answer) = knocks_named("loose_part-900004", "194-nat");
     let salt = truth_integer(&answer, "salt");
     let truth: Vec<f64> = (0..13).map(|n| knock_instant(salt, n)).collect();
-    let given = whole_library(&problem)
-        .unexplained_as_given
-        .expect("a 194-nat miss is not nothing");
-    assert!(
-        matches!(given.fingerprint, Fingerprint::Unknown { .. }),
-        "{:?}",
-        given.fingerprint
-    );
-    assert!(given.suggestion.contains("jolted"), "{}", given.suggestion);
-    for s in &given.spans {
+    for s in &knocks {
         assert!(
             truth.iter().any(|&t| (s.t_start - t).abs() <= 0.005),
             "a knock at {} s; the truth's at {truth:?}",

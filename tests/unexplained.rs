@@ -16,9 +16,9 @@
 
 mod beyond;
 
-use beyond::{fixture, truth_integer, truth_value};
+use beyond::{fixture, truth_integer, truth_value, whole_library};
 
-use motorcal::discover::{Diagnosis, DiscoverSettings, Fingerprint, Unexplained, discover};
+use motorcal::discover::{DiscoverSettings, Fingerprint, Unexplained, discover};
 use motorcal::study::cases::{CaseOptions, make_case};
 use motorcal::study::{InputProfile, Problem};
 
@@ -46,14 +46,6 @@ fn settings() -> DiscoverSettings {
     };
     s.run.quiet = true;
     s
-}
-
-/// The diagnosis with the whole library, the dynamic terms included, as `diagnose` runs by
-/// default.
-fn whole_library(problem: &Problem) -> Diagnosis {
-    let mut s = settings();
-    s.candidates = None;
-    discover(problem, &s).unwrap()
 }
 
 fn verdict(problem: &Problem) -> Option<Unexplained> {

@@ -4,6 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
+use motorcal::discover::{Diagnosis, DiscoverSettings, discover};
 use motorcal::study::Problem;
 
 /// The case `name`: its problem (recording and nominal model) and its `answer.json`.
@@ -33,4 +34,17 @@ fn truth_field<'a>(answer: &'a serde_json::Value, key: &str) -> &'a str {
     let text = answer["truth"].as_str().unwrap();
     let at = text.find(&format!("{key}: ")).unwrap() + key.len() + 2;
     text[at..].split([',', ' ', '}']).next().unwrap()
+}
+
+/// The diagnosis with the whole library, the dynamic terms included, as `diagnose` runs by
+/// default, ranked only and quiet (the verdicts are made before any fit is sampled).
+#[allow(dead_code)] // each test binary compiles this module; not every one diagnoses
+pub fn whole_library(problem: &Problem) -> Diagnosis {
+    let mut settings = DiscoverSettings {
+        rank_only: true,
+        candidates: None,
+        ..DiscoverSettings::default()
+    };
+    settings.run.quiet = true;
+    discover(problem, &settings).unwrap()
 }
