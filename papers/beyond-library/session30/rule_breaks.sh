@@ -1,15 +1,9 @@
 #!/usr/bin/env bash
-# Session 30: rule_breaks.py over every set of $T/tNAME, into rule-breaks-NAME.txt. From the root.
+# Session 30: rule_breaks.py over every set of sets.sh in $T/tNAME, into rule-breaks-NAME.txt.
+# From the root.
 set -e
 T=${T:-/tmp/s30/b}; B=papers/beyond-library; NAME=$1
+. $B/session30/sets.sh
 args=""
-for p in h51:library-residual.md h78:session19/library-residual-780000.md h79:session21/library-residual-790000.md \
-         h79v:session21/library-residual-790000.md h81:session22/library-residual-810000.md \
-         h82:session23/library-residual-820000.md h82v:session23/library-residual-820000.md \
-         h83:session25/library-residual-830000.md h83v:session25/library-residual-830000.md \
-         h85v:session28/library-residual-850000.md h90:session30/library-residual-900000.md \
-         h76:session9/library-residual-760000.md h77:session9/library-residual-770000.md \
-         h68:session6/library-residual-680000.md; do
-  S=${p%%:*}; L=${p##*:}; args="$args $T/cases/$S:$T/t$NAME/$S:$L"
-done
+for p in $SETS; do S=${p%%:*}; L=${p##*:}; args="$args $T/cases/$S:$T/t$NAME/$S:$L"; done
 (cd $B && python3 rule_breaks.py $args) > $B/session30/rule-breaks-$NAME.txt

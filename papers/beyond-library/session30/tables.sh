@@ -1,15 +1,10 @@
 #!/usr/bin/env bash
-# Session 30's kind tables (kind_table.py per set, as session 29's run.sh made them, with this
-# session's thirteenth set h90) of the reports $T/tNAME, into kind-tables-NAME.md. From the root.
+# Session 30's kind tables (kind_table.py per set of sets.sh) of the reports $T/tNAME, into
+# kind-tables-NAME.md. From the root.
 set -e
 T=${T:-/tmp/s30/b}; B=papers/beyond-library; HERE=$B/session30; NAME=$1
-for p in h51:library-residual.md h78:session19/library-residual-780000.md h79:session21/library-residual-790000.md \
-         h79v:session21/library-residual-790000.md h81:session22/library-residual-810000.md \
-         h82:session23/library-residual-820000.md h82v:session23/library-residual-820000.md \
-         h83:session25/library-residual-830000.md h83v:session25/library-residual-830000.md \
-         h85v:session28/library-residual-850000.md h90:session30/library-residual-900000.md \
-         h76:session9/library-residual-760000.md h77:session9/library-residual-770000.md \
-         h68:session6/library-residual-680000.md; do
+. $HERE/sets.sh
+for p in $SETS; do
   S=${p%%:*}; L=${p##*:}
   echo "### $S"; (cd $B && python3 kind_table.py $T/cases/$S:$T/t$NAME/$S:$L)
 done > $HERE/kind-tables-$NAME.md

@@ -49,4 +49,6 @@ for d in sorted(glob.glob(f"{root}/*/*/")):
     else:
         salt = int(re.search(r"salt: (\d+)", truth).group(1))
         true = [round(knock(salt, k), 4) for k in range(13) if knock(salt, k) < 0.5]
-        print(f"{n}: true knocks {true}; found as given {knocks_of(r, 'unexplained_as_given')}")
+        found = knocks_of(r, "unexplained_as_given")
+        near = [round(1e3 * min((k - t for t in true), key=abs), 1) for k in found]
+        print(f"{n}: true knocks {true}; found as given {found} ({near} ms from the nearest true one)")
