@@ -28,7 +28,8 @@
 //! records, `--volts 2`), `emi_bursts`, `supply_dips`, `seal_friction`, `sensor_hysteresis`;
 //! an eleventh, `sample_jitter`, `asymmetric_tacho`, `encoder_missing_line` (the last on slow
 //! records, `--volts 2`); a twelfth, `encoder_missing_pulse` (on slow records, `--volts 2`); a thirteenth (session 30),
-//! `dead_time`, `winding_heat`, `ac_coupled_tacho`, `loose_part`.
+//! `dead_time`, `winding_heat`, `ac_coupled_tacho`, `loose_part`; a fourteenth (session 31),
+//! `gravity_arm`, `brake_release`, `current_offset_step`, `speed_range_switch`.
 //!
 //! cargo run --release --example beyond_library_cases -- [--out DIR] [--per-effect 3]
 //!     [--seed-base 510000] [--min-nats 20] [--max-nats 300] [--effects a,b,…] [--volts 24]
@@ -272,6 +273,19 @@ enum Effect {
     /// A loose part knocking on the shaft: torque pulses of a, 2 ms long, one at a random
     /// instant in each 40-ms window, of random sign. `--effects loose_part`.
     LoosePart { a: f64, salt: u64 },
+    /// An arm lifted through a gearbox of ratio n (20–60): its weight is a torque
+    /// a·sin(k·θ + φ) at the motor, k = 1/n, an order far below a whole one.
+    /// `--effects gravity_arm`.
+    GravityArm { a: f64, k: f64, phase: f64 },
+    /// A holding brake still releasing as the record starts: a drag a·exp(−t/τ_b)·tanh(ω/1),
+    /// τ_b 20–100 ms. `--effects brake_release`.
+    BrakeRelease { a: f64, tau_b: f64 },
+    /// The current sensor re-zeroing its offset at an instant: what is read of I steps by b
+    /// at t_z (0.1–0.4 s). `--effects current_offset_step`.
+    CurrentOffsetStep { b: f64, t_z: f64 },
+    /// A speed estimator that changes its method above a speed: ω read as ω·(1 + ε) above
+    /// a share (0.3–0.8) of the record's no-load speed, as ω below. `--effects speed_range_switch`.
+    SpeedRangeSwitch { eps: f64, share: f64 },
 }
 
 /// splitmix64's finalizer: the draws below of a case's salt and a sample's or a window's index.
@@ -511,6 +525,23 @@ impl Effect {
                 a: 1e-3,
                 salt: rng.random(),
             },
+            "gravity_arm" => Effect::GravityArm {
+                a: 1e-2,
+                k: 1.0 / rng.random_range(20.0..60.0),
+                phase: rng.random_range(0.0..2.0 * PI),
+            },
+            "brake_release" => Effect::BrakeRelease {
+                a: 1e-2,
+                tau_b: rng.random_range(0.02..0.1),
+            },
+            "current_offset_step" => Effect::CurrentOffsetStep {
+                b: 1.0,
+                t_z: rng.random_range(0.1..0.4),
+            },
+            "speed_range_switch" => Effect::SpeedRangeSwitch {
+                eps: 0.01,
+                share: rng.random_range(0.3..0.8),
+            },
             other => panic!("unknown effect {other}; known: {:?}", Effect::NAMES),
         }
     }
@@ -575,6 +606,9 @@ impl Effect {
             Effect::WindingHeat { alpha, .. } => alpha,
             Effect::AcCoupledTacho { tau } => 1.0 / tau,
             Effect::LoosePart { a, .. } => a,
+            Effect::GravityArm { a, .. } | Effect::BrakeRelease { a, .. } => a,
+            Effect::CurrentOffsetStep { b, .. } => b,
+            Effect::SpeedRangeSwitch { eps, .. } => eps,
         }
     }
 
@@ -637,6 +671,9 @@ impl Effect {
             Effect::WindingHeat { alpha, .. } => *alpha = s,
             Effect::AcCoupledTacho { tau } => *tau = 1.0 / s,
             Effect::LoosePart { a, .. } => *a = s,
+            Effect::GravityArm { a, .. } | Effect::BrakeRelease { a, .. } => *a = s,
+            Effect::CurrentOffsetStep { b, .. } => *b = s,
+            Effect::SpeedRangeSwitch { eps, .. } => *eps = s,
         }
         e
     }
@@ -702,6 +739,11 @@ impl Effect {
             Effect::DeadTime { .. } => 4.0,
             Effect::AcCoupledTacho { .. } => 10.0,
             Effect::LoosePart { .. } => 1.0,
+            // An arm's or a brake's torque of at most 1 N·m (the motor's starting torque is
+            // 2.4); an offset of at most 50 A; an estimator's gain off by at most half.
+            Effect::GravityArm { .. } | Effect::BrakeRelease { .. } => 1.0,
+            Effect::CurrentOffsetStep { .. } => 50.0,
+            Effect::SpeedRangeSwitch { .. } => 0.5,
             _ => 1.0,
         }
     }
@@ -914,6 +956,13 @@ fn rhs(
                 }
             }
         }
+        Some(&Effect::GravityArm { a, k, phase }) => {
+            torque -= a * (k * x[2] + phase).sin();
+            dx[2] = w;
+        }
+        Some(&Effect::BrakeRelease { a, tau_b }) => {
+            torque -= a * (-t.max(0.0) / tau_b).exp() * w.tanh();
+        }
         // These act on what is measured (`measured`, `simulate`), not on the motor.
         Some(
             Effect::LeakageCurrent { .. }
@@ -931,7 +980,9 @@ fn rhs(
             | Effect::EmiBursts { .. }
             | Effect::SensorHysteresis { .. }
             | Effect::SampleJitter { .. }
-            | Effect::AsymmetricTacho { .. },
+            | Effect::AsymmetricTacho { .. }
+            | Effect::CurrentOffsetStep { .. }
+            | Effect::SpeedRangeSwitch { .. },
         )
         // Their balances are rewritten below.
         | Some(Effect::MountResonance { .. } | Effect::ShortedTurn { .. })
@@ -1055,6 +1106,16 @@ fn simulate(m: &Motor, e: Option<&Effect>, input: &Input, times: &[f64]) -> Vec<
             } else {
                 last_read = y[1];
             }
+        }
+        if let Some(&Effect::CurrentOffsetStep { b, t_z }) = e
+            && t >= t_z
+        {
+            y[0] += b;
+        }
+        if let Some(&Effect::SpeedRangeSwitch { eps, share }) = e
+            && y[1].abs() > share * input.level / m.c_m
+        {
+            y[1] *= 1.0 + eps;
         }
         if let Some(&Effect::EncoderGlitch { a, salt }) = e
             && let Some(sign) = glitch(salt, out.len())
@@ -1289,6 +1350,14 @@ fn expected(e: &Effect, input_level: f64) -> String {
         Effect::AcCoupledTacho { .. } => r#"{"kind": "state", "balance": "measurement:omega", "functions": ["theta"]}"#.into(),
         // Knocks at random instants follow nothing of the motor: something is left on ω.
         Effect::LoosePart { .. } => r#"{"kind": "unknown", "channel": "omega"}"#.into(),
+        // The arm's weight in the angle, at an order far below a whole one.
+        Effect::GravityArm { k, .. } => format!(r#"{{"kind": "state", "balance": "torque", "functions": ["sin(k*theta)", "cos(k*theta)"], "k": {k}}}"#),
+        // A drag that fades with time: a drift in time of the torque balance.
+        Effect::BrakeRelease { .. } => r#"{"kind": "drift", "variable": "time", "balance": "torque"}"#.into(),
+        // What is read of I, a function of time alone (a step): a drift in time there.
+        Effect::CurrentOffsetStep { .. } => r#"{"kind": "drift", "variable": "time", "balance": "measurement:I"}"#.into(),
+        // What is read of ω, a function of ω (a step in the gain): the kind and the place.
+        Effect::SpeedRangeSwitch { .. } => r#"{"kind": "state", "balance": "measurement:omega"}"#.into(),
         // The flux's ripple in both balances (as flux_saturation's): the kind, the angle and
         // the order are asked.
         Effect::CommutatorRipple { k, .. } => format!(r#"{{"kind": "state", "functions": ["omega*sin(k*theta)", "omega*cos(k*theta)", "I*sin(k*theta)", "I*cos(k*theta)"], "k": {k}}}"#),
