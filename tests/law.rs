@@ -323,6 +323,7 @@ fn the_dictionary_at_one_point_gives_each_shared_factor_its_own_formula_in_any_o
         current_limit: 200.0,
         spot_angle: 2.4,
         spot_width: 0.3,
+        fade: 0.05,
     };
     // A direction through every state at once, so a factor taken for another one shows.
     let x = Point {

@@ -8,12 +8,12 @@ use serde::Serialize;
 
 use crate::motor::Term;
 use crate::motor::dictionary::{
-    self, BALANCES, CURRENT_LIMIT, FUNCTIONS, N_FUNCTIONS, OMEGA_SPOT, STRIBECK, Spot,
+    self, BALANCES, CURRENT_LIMIT, FADE, FUNCTIONS, N_FUNCTIONS, OMEGA_SPOT, STRIBECK, Spot,
     reads_harmonic,
 };
 
 use super::candidate::Candidate;
-use super::unexplained::{EquationTerm, equation_with, with_shapes, with_spot};
+use super::unexplained::{EquationTerm, equation_with, with_fade, with_shapes, with_spot};
 
 /// One function of a discovered law: its coefficient at the MAP and the 95% interval of the
 /// Laplace approximation there (MAP ± 1.96 sd; the coefficients have real support, so the
@@ -48,6 +48,9 @@ pub struct Discovered {
     /// The spot's θ₀ and w [rad] (`theta_0`, `w`), where the law holds a spot of the angle.
     #[serde(flatten, skip_serializing_if = "Option::is_none")]
     pub spot: Option<Spot>,
+    /// The fade's time constant τ [s], where the law holds `exp(-t/tau)`.
+    #[serde(rename = "tau", skip_serializing_if = "Option::is_none")]
+    pub fade: Option<f64>,
     /// The law's functions in its other balances, where it holds more than one (a law
     /// extended by a function of another balance): each balance with its functions.
     #[serde(skip_serializing_if = "Vec::is_empty")]
@@ -116,9 +119,11 @@ pub fn discovered(fit: &Candidate, gained: f64) -> Option<Discovered> {
         .then_some(law.shapes.frequency);
     let current_limit = holds(CURRENT_LIMIT).then_some(law.shapes.current_limit);
     let spot = holds(OMEGA_SPOT).then(|| Spot::of(&law.shapes));
+    let fade = holds(FADE).then_some(law.shapes.fade);
     let mut law = Discovered {
         equation: String::new(),
         spot,
+        fade,
         omega_s,
         k,
         current_limit,
@@ -139,14 +144,17 @@ impl Discovered {
                 .iter()
                 .map(|f| (f.name.clone(), f.coefficient, Some((f.q025, f.q975))))
                 .collect();
-            with_spot(
-                with_shapes(
-                    equation_with(balance, &terms),
-                    self.k,
-                    self.current_limit,
-                    self.frequency_hz,
+            with_fade(
+                with_spot(
+                    with_shapes(
+                        equation_with(balance, &terms),
+                        self.k,
+                        self.current_limit,
+                        self.frequency_hz,
+                    ),
+                    self.spot,
                 ),
-                self.spot,
+                self.fade,
             )
         };
         let mut equation = one(&self.balance, &self.functions);

@@ -19,8 +19,8 @@ use rayon::prelude::*;
 use crate::error::Error;
 use crate::motor::Term;
 use crate::motor::dictionary::{
-    self, BALANCES, CURRENT_LIMIT, FUNCTIONS, N_FUNCTIONS, ODE_BALANCES, OMEGA_SPOT, PERIODIC,
-    RIPPLES, STRIBECK, SUPPLY_RIPPLE, reads_frequency, reads_harmonic, ripple_of,
+    self, BALANCES, CURRENT_LIMIT, FADE, FUNCTIONS, N_FUNCTIONS, ODE_BALANCES, OMEGA_SPOT,
+    PERIODIC, RIPPLES, STRIBECK, SUPPLY_RIPPLE, reads_frequency, reads_harmonic, ripple_of,
 };
 use crate::motor::terms::Law;
 use crate::parameter::ParamId;
@@ -289,13 +289,14 @@ pub fn named_term(problem: &Problem, fingerprint: &Fingerprint) -> Option<NamedT
             )
         }
         Fingerprint::State { .. } | Fingerprint::Drift { .. } => {
-            let (balance, functions, omega_s, harmonic, current_limit) = match fingerprint {
+            let (balance, functions, omega_s, harmonic, current_limit, fade) = match fingerprint {
                 Fingerprint::State {
                     balance,
                     functions,
                     omega_s,
                     harmonic,
                     current_limit,
+                    fade,
                     harmonic_price,
                     harmonic_width,
                     ..
@@ -304,11 +305,21 @@ pub fn named_term(problem: &Problem, fingerprint: &Fingerprint) -> Option<NamedT
                     // and is refined through the ODE; a spot's (θ₀, w) pays its grid, unrefined.
                     search_penalty = *harmonic_price;
                     harmonic_search = (*harmonic_width > 0.0).then_some(*harmonic_width);
-                    (balance, functions, *omega_s, *harmonic, *current_limit)
+                    (
+                        balance,
+                        functions,
+                        *omega_s,
+                        *harmonic,
+                        *current_limit,
+                        *fade,
+                    )
                 }
                 Fingerprint::Drift {
-                    balance, functions, ..
-                } => (balance, functions, None, None, None),
+                    balance,
+                    functions,
+                    fade,
+                    ..
+                } => (balance, functions, None, None, None, *fade),
                 _ => return None,
             };
             let Some(Term::Law(law)) = Term::named("law") else {
@@ -331,6 +342,9 @@ pub fn named_term(problem: &Problem, fingerprint: &Fingerprint) -> Option<NamedT
             }
             if let Some(i) = current_limit {
                 law.shapes.current_limit = i;
+            }
+            if let Some(tau) = fade {
+                law.shapes.fade = tau;
             }
             if let Fingerprint::State { spot: Some(p), .. } = fingerprint {
                 (law.shapes.spot_angle, law.shapes.spot_width) = (p.theta_0, p.w);
@@ -493,7 +507,7 @@ fn reads(law: &Law, frequency: bool) -> bool {
     })
 }
 
-/// `held` with `more`'s functions as well; a shape (ω_s, k, f, I_lim) `held` has no function
+/// `held` with `more`'s functions as well; a shape (ω_s, k, f, I_lim, a spot, τ) `held` has no function
 /// of is taken from `more`.
 fn extended(held: &Law, more: &Law) -> Law {
     let has = |law: &Law, fs: &[usize]| law.active.iter().any(|k| fs.contains(&(k % N_FUNCTIONS)));
@@ -515,6 +529,9 @@ fn extended(held: &Law, more: &Law) -> Law {
     if !has(held, &[OMEGA_SPOT]) && has(more, &[OMEGA_SPOT]) {
         (law.shapes.spot_angle, law.shapes.spot_width) =
             (more.shapes.spot_angle, more.shapes.spot_width);
+    }
+    if !has(held, &[FADE]) && has(more, &[FADE]) {
+        law.shapes.fade = more.shapes.fade;
     }
     law
 }

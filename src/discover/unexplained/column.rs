@@ -7,7 +7,7 @@ use crate::motor::dictionary::Spot;
 use super::spot::SpotShape;
 
 /// A column of the regression: a function (dictionary index) and the shape it has, the
-/// Stribeck speed, the angle's harmonic, the current limit or a spot of the angle.
+/// Stribeck speed, the angle's harmonic, the current limit, a spot of the angle or a fade's time constant.
 pub(super) struct Column {
     pub function: usize,
     pub shape: Shape,
@@ -35,6 +35,13 @@ impl Column {
     pub fn current_limit(&self) -> Option<f64> {
         match self.shape {
             Shape::CurrentLimit(i) => Some(i),
+            _ => None,
+        }
+    }
+
+    pub fn fade(&self) -> Option<f64> {
+        match self.shape {
+            Shape::Fade(tau) => Some(tau),
             _ => None,
         }
     }
@@ -94,4 +101,6 @@ pub(super) enum Shape {
     Harmonic(Harmonic),
     CurrentLimit(f64),
     Spot(SpotShape),
+    /// The time constant τ of exp(−t/τ).
+    Fade(f64),
 }

@@ -68,6 +68,9 @@ pub enum Fingerprint {
         /// one of the functions (`theta_0`, `w` in the JSON).
         #[serde(flatten, skip_serializing_if = "Option::is_none")]
         spot: Option<Spot>,
+        /// The time constant τ [s] of `exp(-t/tau)`, where it is one of the functions.
+        #[serde(rename = "tau", skip_serializing_if = "Option::is_none")]
+        fade: Option<f64>,
         /// The step q of `sin(2*pi*<channel>/q)`, `cos(2*pi*<channel>/q)` (in the channel's
         /// unit), where what is read is rounded to steps (`quantized`).
         #[serde(rename = "q", skip_serializing_if = "Option::is_none")]
@@ -88,6 +91,9 @@ pub enum Fingerprint {
         variable: String,
         balance: String,
         functions: Vec<LawFunction>,
+        /// The time constant τ [s] of `exp(-t/tau)`, where it is one of the functions.
+        #[serde(rename = "tau", skip_serializing_if = "Option::is_none")]
+        fade: Option<f64>,
         score: f64,
     },
     Unknown {
@@ -106,6 +112,7 @@ impl Fingerprint {
             harmonic: None,
             current_limit: None,
             spot: None,
+            fade: None,
             step: None,
             harmonic_price: 0.0,
             harmonic_width: 0.0,
@@ -241,34 +248,57 @@ impl Fingerprint {
                 with_spot(equation(balance, functions), Some(*spot))
             ),
             Fingerprint::State {
-                balance, functions, ..
+                balance,
+                functions,
+                fade,
+                ..
             }
             | Fingerprint::Drift {
-                balance, functions, ..
+                balance,
+                functions,
+                fade,
+                ..
             } if balance.starts_with("measurement:") => format!(
                 "what is read of {} follows the state: {} fits what is left — a sensor that \
                  also reads the input (a leakage path on the supply side of a current \
                  sensor), reads nonlinearly, clips at its range or drifts (the term law, in \
                  what is read)",
                 balance.trim_start_matches("measurement:"),
-                equation(balance, functions)
+                with_fade(equation(balance, functions), *fade)
             ),
             Fingerprint::State {
                 balance,
                 functions,
                 harmonic,
                 current_limit,
+                fade,
                 ..
             } => format!(
                 "the {balance} balance follows the state: {} fits what is left (the term \
                  law); a record with another input would confirm the law beyond this one's \
                  states",
-                with_shapes(
-                    equation(balance, functions),
-                    *harmonic,
-                    *current_limit,
-                    None
+                with_fade(
+                    with_shapes(
+                        equation(balance, functions),
+                        *harmonic,
+                        *current_limit,
+                        None
+                    ),
+                    *fade
                 )
+            ),
+            Fingerprint::Drift {
+                balance,
+                functions,
+                fade: Some(tau),
+                ..
+            } => format!(
+                "the {balance} balance changes with time and settles, with a time constant of \
+                 {:.1} ms: {} fits what is left (the term law): a holding brake still \
+                 releasing, a supply or a zero settling after switch-on; a record started \
+                 later, or twice in a row, would show whether it comes back",
+                tau * 1e3,
+                with_fade(equation(balance, functions), Some(*tau))
             ),
             Fingerprint::Drift {
                 variable,
@@ -331,6 +361,14 @@ pub fn with_spot(equation: String, spot: Option<Spot>) -> String {
         Some(s) => equation
             .replace("θ-θ_0", &format!("θ-{:.3}", s.theta_0))
             .replace("/w^2", &format!("/{:.3}^2", s.w)),
+        None => equation,
+    }
+}
+
+/// A fade's time constant written into its equation: `exp(-t/35.4 ms)` for τ = 35.4 ms.
+pub fn with_fade(equation: String, fade: Option<f64>) -> String {
+    match fade {
+        Some(tau) => equation.replace("exp(-t/τ)", &format!("exp(-t/{:.1} ms)", tau * 1e3)),
         None => equation,
     }
 }

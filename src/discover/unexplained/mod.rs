@@ -71,7 +71,7 @@ pub use as_given::{AsGiven, beyond_the_library};
 pub use context::{Context, Scored};
 pub use figure::{FOLDED_BINS, Folded, UnexplainedFigure};
 pub use fingerprint::{
-    EquationTerm, Fingerprint, LawFunction, equation_with, with_shapes, with_spot,
+    EquationTerm, Fingerprint, LawFunction, equation_with, with_fade, with_shapes, with_spot,
 };
 use generic::{Generic, GenericKind};
 pub use oscillation::{frequency_search_cost, lowest_frequency_over};

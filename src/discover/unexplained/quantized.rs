@@ -94,6 +94,7 @@ pub(super) fn evidence(ctx: &Context, c: usize, shift: f64) -> Option<Evidence> 
             harmonic: None,
             current_limit: None,
             spot: None,
+            fade: None,
             step: Some(1.0 / nu),
             harmonic_price: 0.0,
             harmonic_width: 0.0,

@@ -6,8 +6,8 @@ use nalgebra::DMatrix;
 
 use crate::motor::Term;
 use crate::motor::dictionary::{
-    self, CONSTANT, CURRENT_LIMIT, N_FUNCTIONS, OMEGA_SPOT, Point, READING_RIPPLE, RIPPLES, Shapes,
-    THETA,
+    self, CONSTANT, CURRENT_LIMIT, FADE, N_FUNCTIONS, OMEGA_SPOT, Point, READING_RIPPLE, RIPPLES,
+    Shapes, THETA,
 };
 
 use super::super::candidate::Candidate;
@@ -61,7 +61,8 @@ const SPEED: usize = 0;
 /// to what is read, not to a balance: the column is the function itself, no solve needed),
 /// selected as a balance's are; the law's measurement balances hold them, so a fingerprint
 /// here names a law as a balance's does (`named`). The current is also offered beyond each of
-/// `current_limits` (`sign(I)*max(|I|-I_lim,0)`): a reading clipped at its sensor's or its
+/// `current_limits` (`sign(I)*max(|I|-I_lim,0)`), and a fade at each of `fades` (a zero
+/// settling after switch-on, exp(−t/τ)): a reading clipped at its sensor's or its
 /// converter's range is I less that, which in the voltage balance would be a drive's limit
 /// acting on the motor — the two told apart by ω, which the clip leaves alone. The speed is
 /// also offered times the angle's ripple at each of `harmonics` (θ the predicted speed's
@@ -73,6 +74,7 @@ pub(super) fn fingerprints(
     ctx: &Context,
     current_limits: &[f64],
     harmonics: &[Harmonic],
+    fades: &[f64],
     per_sample: f64,
     shift: f64,
 ) -> Vec<Evidence> {
@@ -129,6 +131,10 @@ pub(super) fn fingerprints(
                     .map(|&i| Column::new(CURRENT_LIMIT, Shape::CurrentLimit(i))),
             );
         }
+        // A zero that settles (a sensor warming up, its offset fading).
+        if fresh(FADE) {
+            columns.extend(fades.iter().map(|&tau| Column::new(FADE, Shape::Fade(tau))));
+        }
         // The angle's ripple each reading is offered: ω's scaled by the speed, I's alone.
         let ripple = if Some(c) == speed {
             READING_RIPPLE
@@ -145,6 +151,7 @@ pub(super) fn fingerprints(
             .map(|column| Shapes {
                 current_limit: column.current_limit().unwrap_or(law.shapes.current_limit),
                 harmonic: column.harmonic().unwrap_or(law.shapes.harmonic),
+                fade: column.fade().unwrap_or(law.shapes.fade),
                 ..law.shapes
             })
             .collect();

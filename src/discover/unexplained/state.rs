@@ -44,7 +44,8 @@ use nalgebra::DMatrix;
 use crate::error::Error;
 use crate::forward::ForwardModel;
 use crate::motor::dictionary::{
-    self, CURRENT_LIMIT, FUNCTIONS, N_FUNCTIONS, ODE_BALANCES, RIPPLES, STRIBECK, Shapes, ripple_of,
+    self, CURRENT_LIMIT, FADE, FUNCTIONS, N_FUNCTIONS, ODE_BALANCES, RIPPLES, STRIBECK, Shapes,
+    ripple_of,
 };
 use crate::motor::terms::Law;
 use crate::motor::{ActiveTerm, MotorModel, Term};
@@ -63,6 +64,18 @@ const STRIBECK_SHARES: [f64; 6] = [0.004, 0.008, 0.016, 0.032, 0.064, 0.128];
 /// The current limits tried, as shares of the model's largest predicted |I|: a limit cuts the
 /// peak, by a little or by half.
 const CURRENT_LIMIT_SHARES: [f64; 6] = [0.5, 0.6, 0.7, 0.8, 0.9, 0.95];
+
+/// The fade's time constants tried (`dictionary::FADE`): the record's duration halved, and
+/// halved again while at least two sample intervals (a faster fade is over before the second
+/// sample). Halving keeps exp(−t/τ)'s column near its neighbours' (its correlation with the
+/// column at 2τ is 0.94 over a long record), as the Stribeck grid's doubling does, and each
+/// value is one more column tried, paid for by the step's look-elsewhere.
+pub(super) fn fade_grid(duration: f64, interval: f64) -> Vec<f64> {
+    (1..)
+        .map(|j| duration / 2f64.powi(j))
+        .take_while(|&tau| tau >= 2.0 * interval)
+        .collect()
+}
 
 /// At most this many functions per balance: a law longer than that is no longer a fingerprint.
 const MAX_FUNCTIONS: usize = 4;
@@ -138,6 +151,7 @@ fn law_columns(
         Shape::Harmonic(h) => shapes.harmonic = h.k,
         Shape::CurrentLimit(i) => shapes.current_limit = i,
         Shape::Spot(s) => (shapes.spot_angle, shapes.spot_width) = (s.spot.theta_0, s.spot.w),
+        Shape::Fade(tau) => shapes.fade = tau,
     }
     let mut shaped = law.clone().with_active(active);
     shaped.shapes = shapes;
@@ -270,8 +284,12 @@ pub(super) fn fingerprints(
             }
         }
     };
+    let fades: Vec<f64> = match &own {
+        Some(l) if holds(FADE) => vec![l.shapes.fade],
+        _ => fade_grid(ctx.times[ctx.n - 1], ctx.interval()),
+    };
     let plain: Vec<usize> = (0..N_FUNCTIONS)
-        .filter(|&f| f != STRIBECK && f != CURRENT_LIMIT && ripple_of(f).is_none())
+        .filter(|&f| f != STRIBECK && f != CURRENT_LIMIT && f != FADE && ripple_of(f).is_none())
         .filter(|&f| !dictionary::reads_frequency(f))
         // Only what a balance is offered: the others' columns would be solved for nothing.
         .filter(|&f| (0..ODE_BALANCES).any(|b| dictionary::offered_in(f, b)))
@@ -297,6 +315,9 @@ pub(super) fn fingerprints(
     }
     for &i in &current_limits {
         add(vec![CURRENT_LIMIT], Shape::CurrentLimit(i))?;
+    }
+    for &tau in &fades {
+        add(vec![FADE], Shape::Fade(tau))?;
     }
     let mut out = Vec::new();
     for balance in 0..ODE_BALANCES {
@@ -362,6 +383,7 @@ pub(super) fn fingerprints(
         ctx,
         &current_limits,
         &harmonics,
+        &fades,
         speed * ctx.interval(),
         shift,
     ));
@@ -385,12 +407,14 @@ pub(super) fn select(
         let stribeck = chosen.iter().find_map(|&j| columns[j].omega_s());
         let harmonic = chosen.iter().find_map(|&j| columns[j].harmonic());
         let limit = chosen.iter().find_map(|&j| columns[j].current_limit());
+        let fade = chosen.iter().find_map(|&j| columns[j].fade());
         // And one of the angle's two ripples (`dictionary::RIPPLES`).
         let ripple = chosen.iter().find_map(|&j| ripple_of(columns[j].function));
         let open: Vec<usize> = (0..columns.len())
             .filter(|j| !chosen.contains(j))
             .filter(|&j| stribeck.is_none() || columns[j].omega_s().is_none())
             .filter(|&j| limit.is_none() || columns[j].current_limit().is_none())
+            .filter(|&j| fade.is_none() || columns[j].fade().is_none())
             .filter(|&j| {
                 harmonic.is_none() || columns[j].harmonic().is_none_or(|k| Some(k) == harmonic)
             })
@@ -457,16 +481,18 @@ pub(super) fn select(
         .collect();
     let balance = balance.to_string();
     let drift = |f: &LawFunction| match f.name.as_str() {
-        "t" => Some("time"),
+        "t" | "exp(-t/tau)" => Some("time"),
         "charge" | "U*charge" => Some("charge"),
         "heat" => Some("heat"),
         _ => None,
     };
+    let fade = chosen.iter().find_map(|&j| columns[j].fade());
     let fingerprint = if functions.iter().all(|f| drift(f).is_some()) {
         Fingerprint::Drift {
             variable: drift(&functions[0]).expect("checked").to_string(),
             balance,
             functions,
+            fade,
             score: score - shift,
         }
     } else {
@@ -477,6 +503,7 @@ pub(super) fn select(
             harmonic: chosen.iter().find_map(|&j| columns[j].harmonic()),
             current_limit: chosen.iter().find_map(|&j| columns[j].current_limit()),
             spot: chosen.iter().find_map(|&j| columns[j].spot()),
+            fade,
             step: None,
             harmonic_price: chosen
                 .iter()

@@ -12,7 +12,7 @@ use super::terms::{exp_below_one, tanh};
 use super::{Magnitudes, Scalar};
 
 /// The functions, in the order of the law's parameters (within each balance).
-pub const FUNCTIONS: [&str; 30] = [
+pub const FUNCTIONS: [&str; 31] = [
     "omega",
     "omega*|omega|",
     "omega^3",
@@ -43,6 +43,7 @@ pub const FUNCTIONS: [&str; 30] = [
     "omega*sin(k*theta)",
     "omega*cos(k*theta)",
     "omega*exp(-2*(1-cos(theta-theta_0))/w^2)",
+    "exp(-t/tau)",
 ];
 
 /// How many functions the dictionary holds.
@@ -140,6 +141,14 @@ pub const READING_RIPPLE: [usize; 2] = [OMEGA_SIN_THETA, OMEGA_COS_THETA];
 /// coefficient and its search over θ₀ and w (`unexplained::spot`).
 pub const OMEGA_SPOT: usize = 29;
 
+/// A change with time that settles, exp(−t/τ) from the record's start (τ a shape, searched as
+/// ω_s is): a holding brake still releasing, a supply or a sensor's zero settling after
+/// switch-on. `t` alone, the only other function of time, is a change that goes on at one
+/// rate; a change that settles within the record was named by whatever state variable moves
+/// with it there (on a spin-up, the speed's Stribeck hump: brake_release-910006 and -910014,
+/// papers/beyond-library.md, session 31).
+pub const FADE: usize = 30;
+
 /// Which of [`RIPPLES`] function `f` belongs to, if either (none: `f` is not a ripple of the
 /// balances).
 pub fn ripple_of(f: usize) -> Option<usize> {
@@ -236,6 +245,8 @@ pub struct Shapes {
     /// The spot's angle θ₀ and width w [rad] ([`OMEGA_SPOT`]).
     pub spot_angle: f64,
     pub spot_width: f64,
+    /// The time constant τ [s] of the fade exp(−t/τ) ([`FADE`]).
+    pub fade: f64,
 }
 
 /// Where a spot of the angle is and how wide ([`OMEGA_SPOT`]), as a report states it.
@@ -375,6 +386,7 @@ impl<'a, D: Scalar> At<'a, D> {
                 let w2 = s.spot_width * s.spot_width;
                 x.speed * exp_below_one((off.cos() - 1.0) * (2.0 / w2))
             }
+            FADE => D::from((-x.t / s.fade).exp()),
             _ => unreachable!("the dictionary has {N_FUNCTIONS} functions"),
         }
     }
@@ -450,6 +462,7 @@ pub fn pretty(name: &str) -> String {
         .replace("omega", "ω")
         .replace("theta", "θ")
         .replace("2*pi*f*t", "2πft")
+        .replace("tau", "τ")
         .replace('*', "·")
 }
 

@@ -12,6 +12,7 @@ fn shapes() -> Shapes {
         current_limit: 100.0,
         spot_angle: 0.0,
         spot_width: 0.5,
+        fade: 0.05,
     }
 }
 
@@ -207,4 +208,28 @@ fn a_spot_of_the_angle_reads_the_speed_at_its_centre_once_per_revolution() {
     let gaussian = 7.0 * (-(0.05f64 / 0.2).powi(2)).exp();
     assert!((spot(2.05) / gaussian - 1.0).abs() < 1e-3);
     assert!(spot(2.0 + std::f64::consts::PI) < 1e-40);
+}
+
+/// The fade: one at the record's start, 1/e after τ, the same whatever the state.
+#[test]
+fn a_fade_is_one_at_the_start_and_one_over_e_after_its_time_constant() {
+    let shapes = Shapes {
+        fade: 0.02,
+        ..shapes()
+    };
+    let at = |t: f64, speed: f64| Point {
+        t,
+        current: 3.0,
+        speed,
+        voltage: 24.0,
+        charge: 0.0,
+        heat: 0.0,
+        theta: 1.0,
+    };
+    assert_eq!(value(FADE, &at(0.0, 5.0), &shapes), 1.0);
+    let e = value(FADE, &at(0.02, 5.0), &shapes);
+    assert!((e - (-1.0f64).exp()).abs() < 1e-15);
+    assert_eq!(e, value(FADE, &at(0.02, -900.0), &shapes));
+    assert_eq!(FUNCTIONS[FADE], "exp(-t/tau)");
+    assert_eq!(pretty(FUNCTIONS[FADE]), "exp(-t/τ)");
 }

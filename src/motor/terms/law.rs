@@ -145,6 +145,7 @@ impl PhysicsTerm for Law {
         27 "omega*sin(k*theta)" "N·m·s/rad" "V·s/rad" "A·s/rad" "1",
         28 "omega*cos(k*theta)" "N·m·s/rad" "V·s/rad" "A·s/rad" "1",
         29 "omega*exp(-2*(1-cos(theta-theta_0))/w^2)" "N·m·s/rad" "V·s/rad" "A·s/rad" "1",
+        30 "exp(-t/tau)" "N·m" "V" "A" "rad/s",
     );
     const SETTINGS: &'static [TermSetting] = &[
         TermSetting {
@@ -196,6 +197,13 @@ impl PhysicsTerm for Law {
             speed_share: None,
             choices: &[],
         },
+        TermSetting {
+            key: "tau",
+            unit: "s",
+            default: 0.05,
+            speed_share: None,
+            choices: &[],
+        },
     ];
     const STATES: &'static [TermState] = &[
         TermState {
@@ -223,6 +231,7 @@ impl PhysicsTerm for Law {
                 current_limit: positive_setting(Self::NAME, "I_lim", s[4])?,
                 spot_angle: finite_setting(Self::NAME, "theta_0", s[5])?,
                 spot_width: positive_setting(Self::NAME, "w", s[6])?,
+                fade: positive_setting(Self::NAME, "tau", s[7])?,
             },
         })
     }
@@ -236,6 +245,7 @@ impl PhysicsTerm for Law {
             self.shapes.current_limit,
             self.shapes.spot_angle,
             self.shapes.spot_width,
+            self.shapes.fade,
         ]
     }
 
