@@ -8,12 +8,12 @@ use serde::Serialize;
 
 use crate::motor::Term;
 use crate::motor::dictionary::{
-    self, BALANCES, CURRENT_LIMIT, FADE, FUNCTIONS, N_FUNCTIONS, OMEGA_SPOT, STRIBECK, Spot,
+    self, BALANCES, CURRENT_LIMIT, FADE, FUNCTIONS, N_FUNCTIONS, OMEGA_SPOT, STEP, STRIBECK, Spot,
     reads_harmonic,
 };
 
 use super::candidate::Candidate;
-use super::unexplained::{EquationTerm, equation_with, with_fade, with_shapes, with_spot};
+use super::unexplained::{EquationTerm, equation_with, with_shapes, with_spot, with_time};
 
 /// One function of a discovered law: its coefficient at the MAP and the 95% interval of the
 /// Laplace approximation there (MAP ± 1.96 sd; the coefficients have real support, so the
@@ -51,6 +51,9 @@ pub struct Discovered {
     /// The fade's time constant τ [s], where the law holds `exp(-t/tau)`.
     #[serde(rename = "tau", skip_serializing_if = "Option::is_none")]
     pub fade: Option<f64>,
+    /// The step's instant t_s [s], where the law holds `step(t-t_s)`.
+    #[serde(rename = "t_s", skip_serializing_if = "Option::is_none")]
+    pub instant: Option<f64>,
     /// The law's functions in its other balances, where it holds more than one (a law
     /// extended by a function of another balance): each balance with its functions.
     #[serde(skip_serializing_if = "Vec::is_empty")]
@@ -120,10 +123,12 @@ pub fn discovered(fit: &Candidate, gained: f64) -> Option<Discovered> {
     let current_limit = holds(CURRENT_LIMIT).then_some(law.shapes.current_limit);
     let spot = holds(OMEGA_SPOT).then(|| Spot::of(&law.shapes));
     let fade = holds(FADE).then_some(law.shapes.fade);
+    let instant = holds(STEP).then_some(law.shapes.instant);
     let mut law = Discovered {
         equation: String::new(),
         spot,
         fade,
+        instant,
         omega_s,
         k,
         current_limit,
@@ -144,7 +149,7 @@ impl Discovered {
                 .iter()
                 .map(|f| (f.name.clone(), f.coefficient, Some((f.q025, f.q975))))
                 .collect();
-            with_fade(
+            with_time(
                 with_spot(
                     with_shapes(
                         equation_with(balance, &terms),
@@ -155,6 +160,7 @@ impl Discovered {
                     self.spot,
                 ),
                 self.fade,
+                self.instant,
             )
         };
         let mut equation = one(&self.balance, &self.functions);

@@ -19,8 +19,8 @@ use rayon::prelude::*;
 use crate::error::Error;
 use crate::motor::Term;
 use crate::motor::dictionary::{
-    self, BALANCES, CURRENT_LIMIT, FADE, FUNCTIONS, N_FUNCTIONS, ODE_BALANCES, OMEGA_SPOT,
-    PERIODIC, RIPPLES, STRIBECK, SUPPLY_RIPPLE, reads_frequency, reads_harmonic, ripple_of,
+    self, BALANCES, FUNCTIONS, N_FUNCTIONS, ODE_BALANCES, PERIODIC, RIPPLES, SUPPLY_RIPPLE,
+    ripple_of,
 };
 use crate::motor::terms::Law;
 use crate::parameter::ParamId;
@@ -289,39 +289,47 @@ pub fn named_term(problem: &Problem, fingerprint: &Fingerprint) -> Option<NamedT
             )
         }
         Fingerprint::State { .. } | Fingerprint::Drift { .. } => {
-            let (balance, functions, omega_s, harmonic, current_limit, fade) = match fingerprint {
-                Fingerprint::State {
-                    balance,
-                    functions,
-                    omega_s,
-                    harmonic,
-                    current_limit,
-                    fade,
-                    harmonic_price,
-                    harmonic_width,
-                    ..
-                } => {
-                    // A k the order search found pays its grid, as a searched frequency does,
-                    // and is refined through the ODE; a spot's (θ₀, w) pays its grid, unrefined.
-                    search_penalty = *harmonic_price;
-                    harmonic_search = (*harmonic_width > 0.0).then_some(*harmonic_width);
-                    (
+            let (balance, functions, omega_s, harmonic, current_limit, fade, instant) =
+                match fingerprint {
+                    Fingerprint::State {
                         balance,
                         functions,
-                        *omega_s,
-                        *harmonic,
-                        *current_limit,
-                        *fade,
-                    )
-                }
-                Fingerprint::Drift {
-                    balance,
-                    functions,
-                    fade,
-                    ..
-                } => (balance, functions, None, None, None, *fade),
-                _ => return None,
-            };
+                        omega_s,
+                        harmonic,
+                        current_limit,
+                        fade,
+                        instant,
+                        harmonic_price,
+                        harmonic_width,
+                        ..
+                    } => {
+                        // A k the order search found pays its grid, as a searched frequency does,
+                        // and is refined through the ODE; a spot's (θ₀, w) pays its grid, unrefined.
+                        search_penalty = *harmonic_price;
+                        harmonic_search = (*harmonic_width > 0.0).then_some(*harmonic_width);
+                        (
+                            balance,
+                            functions,
+                            *omega_s,
+                            *harmonic,
+                            *current_limit,
+                            *fade,
+                            *instant,
+                        )
+                    }
+                    Fingerprint::Drift {
+                        balance,
+                        functions,
+                        fade,
+                        instant,
+                        instant_price,
+                        ..
+                    } => {
+                        search_penalty = *instant_price;
+                        (balance, functions, None, None, None, *fade, *instant)
+                    }
+                    _ => return None,
+                };
             let Some(Term::Law(law)) = Term::named("law") else {
                 return None;
             };
@@ -345,6 +353,9 @@ pub fn named_term(problem: &Problem, fingerprint: &Fingerprint) -> Option<NamedT
             }
             if let Some(tau) = fade {
                 law.shapes.fade = tau;
+            }
+            if let Some(t_s) = instant {
+                law.shapes.instant = t_s;
             }
             if let Fingerprint::State { spot: Some(p), .. } = fingerprint {
                 (law.shapes.spot_angle, law.shapes.spot_width) = (p.theta_0, p.w);
@@ -391,7 +402,7 @@ fn fit_named(problem: &Problem, with: &Candidate, named: &NamedTerm) -> Result<C
     };
     // A law extending the one `with` holds keeps the shape that law already reads
     // (`extended`): searched, every value tried would fit the same model.
-    if added_law(with).is_some_and(|held| reads(held, frequency)) {
+    if added_law(with).is_some_and(|held| held.reads(frequency)) {
         return fit_named_at(problem, with, named, None);
     }
     let at = |x: f64| {
@@ -433,7 +444,7 @@ fn fit_named_at(
         // A law named beside a fit that holds one already (the verdict after a law found more
         // in the same balance: the other half of a ripple's phase) extends that law; its
         // coefficients start at the fit's estimates, its shapes are kept where it has them.
-        (Term::Law(more), Some(held)) => Term::Law(extended(held, more)),
+        (Term::Law(more), Some(held)) => Term::Law(held.extended(more)),
         _ => {
             added.push(name.clone());
             named.term.clone()
@@ -492,48 +503,6 @@ pub(super) fn law_of(fit: &Candidate) -> Option<&Law> {
 /// a law named beside it extends it.
 fn added_law(fit: &Candidate) -> Option<&Law> {
     law_of(fit).filter(|_| fit.added.iter().any(|a| a == "law"))
-}
-
-/// Whether `law` holds a function of time's frequency f (`frequency`) or of the angle's
-/// harmonic k (not).
-fn reads(law: &Law, frequency: bool) -> bool {
-    law.active.iter().any(|k| {
-        let f = k % N_FUNCTIONS;
-        if frequency {
-            reads_frequency(f)
-        } else {
-            reads_harmonic(f)
-        }
-    })
-}
-
-/// `held` with `more`'s functions as well; a shape (ω_s, k, f, I_lim, a spot, τ) `held` has no function
-/// of is taken from `more`.
-fn extended(held: &Law, more: &Law) -> Law {
-    let has = |law: &Law, fs: &[usize]| law.active.iter().any(|k| fs.contains(&(k % N_FUNCTIONS)));
-    let mut law = held
-        .clone()
-        .with_active(held.active.iter().chain(&more.active).copied().collect());
-    if !has(held, &[STRIBECK]) && has(more, &[STRIBECK]) {
-        law.shapes.omega_s = more.shapes.omega_s;
-    }
-    if !reads(held, false) && reads(more, false) {
-        law.shapes.harmonic = more.shapes.harmonic;
-    }
-    if !reads(held, true) && reads(more, true) {
-        law.shapes.frequency = more.shapes.frequency;
-    }
-    if !has(held, &[CURRENT_LIMIT]) && has(more, &[CURRENT_LIMIT]) {
-        law.shapes.current_limit = more.shapes.current_limit;
-    }
-    if !has(held, &[OMEGA_SPOT]) && has(more, &[OMEGA_SPOT]) {
-        (law.shapes.spot_angle, law.shapes.spot_width) =
-            (more.shapes.spot_angle, more.shapes.spot_width);
-    }
-    if !has(held, &[FADE]) && has(more, &[FADE]) {
-        law.shapes.fade = more.shapes.fade;
-    }
-    law
 }
 
 /// The fingerprints to name, and the fits to name each beside.

@@ -39,6 +39,13 @@ impl Column {
         }
     }
 
+    pub fn instant(&self) -> Option<f64> {
+        match self.shape {
+            Shape::Step(s) => Some(s.t_s),
+            _ => None,
+        }
+    }
+
     pub fn fade(&self) -> Option<f64> {
         match self.shape {
             Shape::Fade(tau) => Some(tau),
@@ -59,6 +66,7 @@ impl Column {
         match self.shape {
             Shape::Harmonic(h) => h.price,
             Shape::Spot(s) => s.price,
+            Shape::Step(s) => s.price,
             _ => 0.0,
         }
     }
@@ -103,4 +111,13 @@ pub(super) enum Shape {
     Spot(SpotShape),
     /// The time constant τ of exp(−t/τ).
     Fade(f64),
+    /// The instant of step(t − t_s), and what its search cost (ln G).
+    Step(StepShape),
+}
+
+/// A step's instant offered, and what finding it cost (ln G over the instants tried).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct StepShape {
+    pub t_s: f64,
+    pub price: f64,
 }

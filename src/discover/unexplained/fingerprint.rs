@@ -71,6 +71,9 @@ pub enum Fingerprint {
         /// The time constant τ [s] of `exp(-t/tau)`, where it is one of the functions.
         #[serde(rename = "tau", skip_serializing_if = "Option::is_none")]
         fade: Option<f64>,
+        /// The instant t_s [s] of `step(t-t_s)`, where it is one of the functions.
+        #[serde(rename = "t_s", skip_serializing_if = "Option::is_none")]
+        instant: Option<f64>,
         /// The step q of `sin(2*pi*<channel>/q)`, `cos(2*pi*<channel>/q)` (in the channel's
         /// unit), where what is read is rounded to steps (`quantized`).
         #[serde(rename = "q", skip_serializing_if = "Option::is_none")]
@@ -94,6 +97,13 @@ pub enum Fingerprint {
         /// The time constant τ [s] of `exp(-t/tau)`, where it is one of the functions.
         #[serde(rename = "tau", skip_serializing_if = "Option::is_none")]
         fade: Option<f64>,
+        /// The instant t_s [s] of `step(t-t_s)`, where it is one of the functions.
+        #[serde(rename = "t_s", skip_serializing_if = "Option::is_none")]
+        instant: Option<f64>,
+        /// What finding its instant cost (ln G over the instants tried, else 0): a law named
+        /// with it pays it too.
+        #[serde(skip)]
+        instant_price: f64,
         score: f64,
     },
     Unknown {
@@ -113,6 +123,7 @@ impl Fingerprint {
             current_limit: None,
             spot: None,
             fade: None,
+            instant: None,
             step: None,
             harmonic_price: 0.0,
             harmonic_width: 0.0,
@@ -251,12 +262,14 @@ impl Fingerprint {
                 balance,
                 functions,
                 fade,
+                instant,
                 ..
             }
             | Fingerprint::Drift {
                 balance,
                 functions,
                 fade,
+                instant,
                 ..
             } if balance.starts_with("measurement:") => format!(
                 "what is read of {} follows the state: {} fits what is left — a sensor that \
@@ -264,7 +277,7 @@ impl Fingerprint {
                  sensor), reads nonlinearly, clips at its range or drifts (the term law, in \
                  what is read)",
                 balance.trim_start_matches("measurement:"),
-                with_fade(equation(balance, functions), *fade)
+                with_time(equation(balance, functions), *fade, *instant)
             ),
             Fingerprint::State {
                 balance,
@@ -272,25 +285,28 @@ impl Fingerprint {
                 harmonic,
                 current_limit,
                 fade,
+                instant,
                 ..
             } => format!(
                 "the {balance} balance follows the state: {} fits what is left (the term \
                  law); a record with another input would confirm the law beyond this one's \
                  states",
-                with_fade(
+                with_time(
                     with_shapes(
                         equation(balance, functions),
                         *harmonic,
                         *current_limit,
                         None
                     ),
-                    *fade
+                    *fade,
+                    *instant
                 )
             ),
             Fingerprint::Drift {
                 balance,
                 functions,
                 fade: Some(tau),
+                instant,
                 ..
             } => format!(
                 "the {balance} balance changes with time and settles, with a time constant of \
@@ -298,7 +314,7 @@ impl Fingerprint {
                  releasing, a supply or a zero settling after switch-on; a record started \
                  later, or twice in a row, would show whether it comes back",
                 tau * 1e3,
-                with_fade(equation(balance, functions), Some(*tau))
+                with_time(equation(balance, functions), Some(*tau), *instant)
             ),
             Fingerprint::Drift {
                 variable,
@@ -365,12 +381,17 @@ pub fn with_spot(equation: String, spot: Option<Spot>) -> String {
     }
 }
 
-/// A fade's time constant written into its equation: `exp(-t/35.4 ms)` for τ = 35.4 ms.
-pub fn with_fade(equation: String, fade: Option<f64>) -> String {
-    match fade {
-        Some(tau) => equation.replace("exp(-t/τ)", &format!("exp(-t/{:.1} ms)", tau * 1e3)),
-        None => equation,
+/// A fade's time constant and a step's instant written into their equation: `exp(-t/35.4
+/// ms)` for τ = 35.4 ms, `step(t-0.3101 s)` for t_s = 0.3101 s.
+pub fn with_time(equation: String, fade: Option<f64>, instant: Option<f64>) -> String {
+    let mut equation = equation;
+    if let Some(tau) = fade {
+        equation = equation.replace("exp(-t/τ)", &format!("exp(-t/{:.1} ms)", tau * 1e3));
     }
+    if let Some(t_s) = instant {
+        equation = equation.replace("step(t-t_s)", &format!("step(t-{t_s:.4} s)"));
+    }
+    equation
 }
 
 pub fn equation_with(balance: &str, terms: &[EquationTerm]) -> String {

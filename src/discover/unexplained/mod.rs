@@ -46,6 +46,7 @@ mod oscillation;
 mod outliers;
 mod quantized;
 mod reading;
+mod reading_step;
 mod regression;
 mod resonance;
 mod slope_noise;
@@ -71,7 +72,7 @@ pub use as_given::{AsGiven, beyond_the_library};
 pub use context::{Context, Scored};
 pub use figure::{FOLDED_BINS, Folded, UnexplainedFigure};
 pub use fingerprint::{
-    EquationTerm, Fingerprint, LawFunction, equation_with, with_fade, with_shapes, with_spot,
+    EquationTerm, Fingerprint, LawFunction, equation_with, with_shapes, with_spot, with_time,
 };
 use generic::{Generic, GenericKind};
 pub use oscillation::{frequency_search_cost, lowest_frequency_over};

@@ -95,6 +95,7 @@ pub(super) fn evidence(ctx: &Context, c: usize, shift: f64) -> Option<Evidence> 
             current_limit: None,
             spot: None,
             fade: None,
+            instant: None,
             step: Some(1.0 / nu),
             harmonic_price: 0.0,
             harmonic_width: 0.0,

@@ -7,7 +7,7 @@ use nalgebra::DMatrix;
 use crate::motor::Term;
 use crate::motor::dictionary::{
     self, CONSTANT, CURRENT_LIMIT, FADE, N_FUNCTIONS, OMEGA_SPOT, Point, READING_RIPPLE, RIPPLES,
-    Shapes, THETA,
+    STEP, Shapes, THETA,
 };
 
 use super::super::candidate::Candidate;
@@ -181,6 +181,16 @@ pub(super) fn fingerprints(
             shift,
             |_: &Column| true,
         ));
+    }
+    // And a change at an instant on each channel read, a move of its own (its search paid by
+    // its price), where the model's law holds none (a law has one t_s).
+    if !held.iter().any(|k| k % N_FUNCTIONS == STEP) {
+        for (c, channel) in ctx.channels.iter().enumerate() {
+            if Some(c) == current || Some(c) == speed {
+                let balance = format!("measurement:{channel}");
+                out.extend(super::reading_step::fingerprints(ctx, c, &balance, shift));
+            }
+        }
     }
     // And a spot of the angle on ω, a move of its own (its search paid by its price), where
     // the model's law holds none (a law has one θ₀ and w).

@@ -152,6 +152,7 @@ fn law_columns(
         Shape::CurrentLimit(i) => shapes.current_limit = i,
         Shape::Spot(s) => (shapes.spot_angle, shapes.spot_width) = (s.spot.theta_0, s.spot.w),
         Shape::Fade(tau) => shapes.fade = tau,
+        Shape::Step(s) => shapes.instant = s.t_s,
     }
     let mut shaped = law.clone().with_active(active);
     shaped.shapes = shapes;
@@ -481,7 +482,7 @@ pub(super) fn select(
         .collect();
     let balance = balance.to_string();
     let drift = |f: &LawFunction| match f.name.as_str() {
-        "t" | "exp(-t/tau)" => Some("time"),
+        "t" | "exp(-t/tau)" | "step(t-t_s)" => Some("time"),
         "charge" | "U*charge" => Some("charge"),
         "heat" => Some("heat"),
         _ => None,
@@ -493,6 +494,11 @@ pub(super) fn select(
             balance,
             functions,
             fade,
+            instant: chosen.iter().find_map(|&j| columns[j].instant()),
+            instant_price: chosen
+                .iter()
+                .map(|&j| columns[j].price())
+                .fold(0.0, f64::max),
             score: score - shift,
         }
     } else {
@@ -504,6 +510,7 @@ pub(super) fn select(
             current_limit: chosen.iter().find_map(|&j| columns[j].current_limit()),
             spot: chosen.iter().find_map(|&j| columns[j].spot()),
             fade,
+            instant: chosen.iter().find_map(|&j| columns[j].instant()),
             step: None,
             harmonic_price: chosen
                 .iter()
@@ -538,5 +545,15 @@ mod tests {
         assert_eq!(offered, vec![1.0]);
         // A positioning stage at 10 rad/s resolves every slot count of the grid.
         assert!(HARMONICS.iter().all(|&k| sampled_ripple(k, 10.0, 1e-3)));
+    }
+
+    #[test]
+    fn a_fade_is_tried_from_half_the_record_down_to_two_samples() {
+        // 0.5 s at 1 kHz: 250, 125, 62.5, … down to 3.9 ms (1.95 ms would be under two samples).
+        let g = fade_grid(0.5, 1e-3);
+        assert_eq!(g.len(), 7);
+        assert_eq!(g[0], 0.25);
+        assert!((g[6] - 0.5 / 128.0).abs() < 1e-15);
+        assert!(g.windows(2).all(|w| w[1] == w[0] / 2.0));
     }
 }

@@ -12,7 +12,7 @@ use super::terms::{exp_below_one, tanh};
 use super::{Magnitudes, Scalar};
 
 /// The functions, in the order of the law's parameters (within each balance).
-pub const FUNCTIONS: [&str; 31] = [
+pub const FUNCTIONS: [&str; 32] = [
     "omega",
     "omega*|omega|",
     "omega^3",
@@ -44,6 +44,7 @@ pub const FUNCTIONS: [&str; 31] = [
     "omega*cos(k*theta)",
     "omega*exp(-2*(1-cos(theta-theta_0))/w^2)",
     "exp(-t/tau)",
+    "step(t-t_s)",
 ];
 
 /// How many functions the dictionary holds.
@@ -149,6 +150,13 @@ pub const OMEGA_SPOT: usize = 29;
 /// papers/beyond-library.md, session 31).
 pub const FADE: usize = 30;
 
+/// A change at an instant, 0 before t_s and 1 from it on (t_s a shape, searched over the
+/// record's samples, `unexplained::reading_step`): what is read re-zeroed or switched in range
+/// while the record ran, a sensor knocked on its mount. Offered in what is read only: in the
+/// torque balance a load that changes at an instant is the library's `load_step`, whose ramp
+/// gives t_s a derivative, and in either balance each instant tried would be a solve.
+pub const STEP: usize = 31;
+
 /// Which of [`RIPPLES`] function `f` belongs to, if either (none: `f` is not a ripple of the
 /// balances).
 pub fn ripple_of(f: usize) -> Option<usize> {
@@ -214,7 +222,7 @@ pub fn offered_in(f: usize, b: usize) -> bool {
         THETA => b == 0 || b == 3,
         I_SIN_THETA | I_COS_THETA => b == 0,
         OMEGA_SIN_THETA | OMEGA_COS_THETA | OMEGA_SPOT => b == 3,
-        CONSTANT => b >= ODE_BALANCES,
+        CONSTANT | STEP => b >= ODE_BALANCES,
         _ => true,
     }
 }
@@ -247,6 +255,8 @@ pub struct Shapes {
     pub spot_width: f64,
     /// The time constant τ [s] of the fade exp(−t/τ) ([`FADE`]).
     pub fade: f64,
+    /// The instant t_s [s] of the step ([`STEP`]).
+    pub instant: f64,
 }
 
 /// Where a spot of the angle is and how wide ([`OMEGA_SPOT`]), as a report states it.
@@ -387,6 +397,7 @@ impl<'a, D: Scalar> At<'a, D> {
                 x.speed * exp_below_one((off.cos() - 1.0) * (2.0 / w2))
             }
             FADE => D::from((-x.t / s.fade).exp()),
+            STEP => D::from(if x.t >= s.instant { 1.0 } else { 0.0 }),
             _ => unreachable!("the dictionary has {N_FUNCTIONS} functions"),
         }
     }

@@ -13,6 +13,7 @@ fn shapes() -> Shapes {
         spot_angle: 0.0,
         spot_width: 0.5,
         fade: 0.05,
+        instant: 0.25,
     }
 }
 

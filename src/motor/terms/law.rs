@@ -15,7 +15,9 @@ use super::{
     finite_setting, positive_setting, real,
 };
 use crate::motor::Scalar;
-use crate::motor::dictionary::{self, N_FUNCTIONS, ODE_BALANCES, Point, Shapes};
+use crate::motor::dictionary::{
+    self, CURRENT_LIMIT, FADE, N_FUNCTIONS, ODE_BALANCES, OMEGA_SPOT, Point, STEP, STRIBECK, Shapes,
+};
 use crate::parameter::Prior;
 
 #[derive(Clone, Debug, PartialEq)]
@@ -32,6 +34,56 @@ impl Law {
         active.dedup();
         self.active = active;
         self
+    }
+
+    /// Whether the law holds a function of time's frequency f (`frequency`) or of the angle's
+    /// harmonic k (not).
+    pub fn reads(&self, frequency: bool) -> bool {
+        self.active.iter().any(|k| {
+            let f = k % N_FUNCTIONS;
+            if frequency {
+                dictionary::reads_frequency(f)
+            } else {
+                dictionary::reads_harmonic(f)
+            }
+        })
+    }
+
+    /// Whether the law holds any of the functions `fs` (dictionary indices), in any balance.
+    fn holds(&self, fs: &[usize]) -> bool {
+        self.active.iter().any(|k| fs.contains(&(k % N_FUNCTIONS)))
+    }
+
+    /// The law with `more`'s functions as well; a shape (ω_s, k, f, I_lim, a spot, τ, t_s)
+    /// that it has no function of is taken from `more` (a law has one of each).
+    pub fn extended(&self, more: &Law) -> Law {
+        let mut law = self
+            .clone()
+            .with_active(self.active.iter().chain(&more.active).copied().collect());
+        let (s, m) = (&mut law.shapes, &more.shapes);
+        let takes = |fs: &[usize]| !self.holds(fs) && more.holds(fs);
+        if takes(&[STRIBECK]) {
+            s.omega_s = m.omega_s;
+        }
+        if !self.reads(false) && more.reads(false) {
+            s.harmonic = m.harmonic;
+        }
+        if !self.reads(true) && more.reads(true) {
+            s.frequency = m.frequency;
+        }
+        if takes(&[CURRENT_LIMIT]) {
+            s.current_limit = m.current_limit;
+        }
+        if takes(&[OMEGA_SPOT]) {
+            (s.spot_angle, s.spot_width) = (m.spot_angle, m.spot_width);
+        }
+        if takes(&[FADE]) {
+            s.fade = m.fade;
+        }
+        if takes(&[STEP]) {
+            s.instant = m.instant;
+        }
+        law
     }
 
     /// Whether a function of the active set needs state `s` (0 charge, 1 heat, 2 θ).
@@ -146,6 +198,7 @@ impl PhysicsTerm for Law {
         28 "omega*cos(k*theta)" "N·m·s/rad" "V·s/rad" "A·s/rad" "1",
         29 "omega*exp(-2*(1-cos(theta-theta_0))/w^2)" "N·m·s/rad" "V·s/rad" "A·s/rad" "1",
         30 "exp(-t/tau)" "N·m" "V" "A" "rad/s",
+        31 "step(t-t_s)" "N·m" "V" "A" "rad/s",
     );
     const SETTINGS: &'static [TermSetting] = &[
         TermSetting {
@@ -204,6 +257,13 @@ impl PhysicsTerm for Law {
             speed_share: None,
             choices: &[],
         },
+        TermSetting {
+            key: "t_s",
+            unit: "s",
+            default: 0.25,
+            speed_share: None,
+            choices: &[],
+        },
     ];
     const STATES: &'static [TermState] = &[
         TermState {
@@ -232,6 +292,7 @@ impl PhysicsTerm for Law {
                 spot_angle: finite_setting(Self::NAME, "theta_0", s[5])?,
                 spot_width: positive_setting(Self::NAME, "w", s[6])?,
                 fade: positive_setting(Self::NAME, "tau", s[7])?,
+                instant: finite_setting(Self::NAME, "t_s", s[8])?,
             },
         })
     }
@@ -246,6 +307,7 @@ impl PhysicsTerm for Law {
             self.shapes.spot_angle,
             self.shapes.spot_width,
             self.shapes.fade,
+            self.shapes.instant,
         ]
     }
 
