@@ -29,7 +29,9 @@
 //! an eleventh, `sample_jitter`, `asymmetric_tacho`, `encoder_missing_line` (the last on slow
 //! records, `--volts 2`); a twelfth, `encoder_missing_pulse` (on slow records, `--volts 2`); a thirteenth (session 30),
 //! `dead_time`, `winding_heat`, `ac_coupled_tacho`, `loose_part`; a fourteenth (session 31),
-//! `gravity_arm`, `brake_release`, `current_offset_step`, `speed_range_switch`.
+//! `gravity_arm`, `brake_release`, `current_offset_step`, `speed_range_switch`; a fifteenth
+//! (session 31, made after the fade and the step were written, to judge them blind),
+//! `load_mass_change`, `speed_clip`, `sensor_gain_heat`, `brush_bounce`.
 //!
 //! cargo run --release --example beyond_library_cases -- [--out DIR] [--per-effect 3]
 //!     [--seed-base 510000] [--min-nats 20] [--max-nats 300] [--effects a,b,…] [--volts 24]
@@ -286,6 +288,18 @@ enum Effect {
     /// A speed estimator that changes its method above a speed: ω read as ω·(1 + ε) above
     /// a share (0.3–0.8) of the record's no-load speed, as ω below. `--effects speed_range_switch`.
     SpeedRangeSwitch { eps: f64, share: f64 },
+    /// A mass picked up at an instant: the inertia J·(1 + ε) from t_c (0.1–0.4 s) on.
+    /// `--effects load_mass_change`.
+    LoadMassChange { eps: f64, t_c: f64 },
+    /// A speed sensor at the end of its range: what is read of ω clipped at (1 − c) times the
+    /// record's no-load speed. `--effects speed_clip`.
+    SpeedClip { cut: f64 },
+    /// A current sensor whose gain drifts as the winding warms: I·(1 + β·E), E = ∫R·I²dt.
+    /// `--effects sensor_gain_heat`.
+    SensorGainHeat { beta: f64 },
+    /// Brushes bouncing on the commutator: in each 25-ms window, with probability one half, the
+    /// winding sees (1 − d)·U for 1 ms at a random instant. `--effects brush_bounce`.
+    BrushBounce { d: f64, salt: u64 },
 }
 
 /// splitmix64's finalizer: the draws below of a case's salt and a sample's or a window's index.
@@ -542,6 +556,16 @@ impl Effect {
                 eps: 0.01,
                 share: rng.random_range(0.3..0.8),
             },
+            "load_mass_change" => Effect::LoadMassChange {
+                eps: 0.1,
+                t_c: rng.random_range(0.1..0.4),
+            },
+            "speed_clip" => Effect::SpeedClip { cut: 0.01 },
+            "sensor_gain_heat" => Effect::SensorGainHeat { beta: 1e-4 },
+            "brush_bounce" => Effect::BrushBounce {
+                d: 0.1,
+                salt: rng.random(),
+            },
             other => panic!("unknown effect {other}; known: {:?}", Effect::NAMES),
         }
     }
@@ -609,6 +633,10 @@ impl Effect {
             Effect::GravityArm { a, .. } | Effect::BrakeRelease { a, .. } => a,
             Effect::CurrentOffsetStep { b, .. } => b,
             Effect::SpeedRangeSwitch { eps, .. } => eps,
+            Effect::LoadMassChange { eps, .. } => eps,
+            Effect::SpeedClip { cut } => cut,
+            Effect::SensorGainHeat { beta } => beta,
+            Effect::BrushBounce { d, .. } => d,
         }
     }
 
@@ -674,6 +702,10 @@ impl Effect {
             Effect::GravityArm { a, .. } | Effect::BrakeRelease { a, .. } => *a = s,
             Effect::CurrentOffsetStep { b, .. } => *b = s,
             Effect::SpeedRangeSwitch { eps, .. } => *eps = s,
+            Effect::LoadMassChange { eps, .. } => *eps = s,
+            Effect::SpeedClip { cut } => *cut = s,
+            Effect::SensorGainHeat { beta } => *beta = s,
+            Effect::BrushBounce { d, .. } => *d = s,
         }
         e
     }
@@ -744,6 +776,12 @@ impl Effect {
             Effect::GravityArm { .. } | Effect::BrakeRelease { .. } => 1.0,
             Effect::CurrentOffsetStep { .. } => 50.0,
             Effect::SpeedRangeSwitch { .. } => 0.5,
+            // A mass of at most twice the rotor's; a range cut by at most half; a gain up by at
+            // most 0.01 per joule; a bounce that loses the whole supply.
+            Effect::LoadMassChange { .. } => 2.0,
+            Effect::SpeedClip { .. } => 0.5,
+            Effect::SensorGainHeat { .. } => 0.01,
+            Effect::BrushBounce { .. } => 1.0,
             _ => 1.0,
         }
     }
@@ -963,6 +1001,22 @@ fn rhs(
         Some(&Effect::BrakeRelease { a, tau_b }) => {
             torque -= a * (-t.max(0.0) / tau_b).exp() * w.tanh();
         }
+        Some(&Effect::LoadMassChange { eps, t_c }) => {
+            if t >= t_c {
+                motor_inertia = m.j * (1.0 + eps);
+            }
+        }
+        Some(Effect::SensorGainHeat { .. }) => dx[2] = m.r * i * i,
+        Some(&Effect::BrushBounce { d, salt }) => {
+            let window = 0.025;
+            if t >= 0.0 {
+                let n = (t / window) as usize;
+                let start = n as f64 * window + 0.9 * window * salted_uniform(salt, n);
+                if burst_sign(salt, n) > 0.0 && t >= start && t < start + 1e-3 {
+                    u *= 1.0 - d;
+                }
+            }
+        }
         // These act on what is measured (`measured`, `simulate`), not on the motor.
         Some(
             Effect::LeakageCurrent { .. }
@@ -982,7 +1036,8 @@ fn rhs(
             | Effect::SampleJitter { .. }
             | Effect::AsymmetricTacho { .. }
             | Effect::CurrentOffsetStep { .. }
-            | Effect::SpeedRangeSwitch { .. },
+            | Effect::SpeedRangeSwitch { .. }
+            | Effect::SpeedClip { .. },
         )
         // Their balances are rewritten below.
         | Some(Effect::MountResonance { .. } | Effect::ShortedTurn { .. })
@@ -1047,6 +1102,7 @@ fn measured(e: Option<&Effect>, x: &[f64; 4]) -> [f64; 2] {
         }
         Some(&Effect::MagnetPickup { a, phase }) => [x[0] + a * (x[2] + phase).sin(), x[1]],
         Some(&Effect::AsymmetricTacho { eps }) => [x[0], x[1] + eps * x[1].abs()],
+        Some(&Effect::SensorGainHeat { beta }) => [x[0] * (1.0 + beta * x[2]), x[1]],
         Some(Effect::AcCoupledTacho { .. }) => [x[0], x[1] - x[2]],
         Some(&Effect::EncoderMissingLine { eps, phase }) => {
             let wrapped = (x[2] + phase + PI).rem_euclid(2.0 * PI) - PI;
@@ -1111,6 +1167,10 @@ fn simulate(m: &Motor, e: Option<&Effect>, input: &Input, times: &[f64]) -> Vec<
             && t >= t_z
         {
             y[0] += b;
+        }
+        if let Some(&Effect::SpeedClip { cut }) = e {
+            let top = (1.0 - cut) * input.level / m.c_m;
+            y[1] = y[1].clamp(-top, top);
         }
         if let Some(&Effect::SpeedRangeSwitch { eps, share }) = e
             && y[1].abs() > share * input.level / m.c_m
@@ -1358,6 +1418,16 @@ fn expected(e: &Effect, input_level: f64) -> String {
         Effect::CurrentOffsetStep { .. } => r#"{"kind": "drift", "variable": "time", "balance": "measurement:I"}"#.into(),
         // What is read of ω, a function of ω (a step in the gain): the kind and the place.
         Effect::SpeedRangeSwitch { .. } => r#"{"kind": "state", "balance": "measurement:omega"}"#.into(),
+        // An inertia that changes at an instant scales J·dω/dt, which no dictionary function
+        // is: something is left that nothing names.
+        Effect::LoadMassChange { .. } => r#"{"kind": "unknown"}"#.into(),
+        // What is read of ω, a function of ω (a clip): the kind and the place.
+        Effect::SpeedClip { .. } => r#"{"kind": "state", "balance": "measurement:omega"}"#.into(),
+        // What is read of I, drifting with the heat (as sensor_heat_drift's offset does).
+        Effect::SensorGainHeat { .. } => r#"{"kind": "drift", "variable": "heat", "balance": "measurement:I"}"#.into(),
+        // Short losses of the supply at random instants follow nothing of the state:
+        // something is left on I.
+        Effect::BrushBounce { .. } => r#"{"kind": "unknown", "channel": "I"}"#.into(),
         // The flux's ripple in both balances (as flux_saturation's): the kind, the angle and
         // the order are asked.
         Effect::CommutatorRipple { k, .. } => format!(r#"{{"kind": "state", "functions": ["omega*sin(k*theta)", "omega*cos(k*theta)", "I*sin(k*theta)", "I*cos(k*theta)"], "k": {k}}}"#),
