@@ -322,10 +322,10 @@ pub fn named_term(problem: &Problem, fingerprint: &Fingerprint) -> Option<NamedT
                         functions,
                         fade,
                         instant,
-                        instant_price,
+                        shape_price,
                         ..
                     } => {
-                        search_penalty = *instant_price;
+                        search_penalty = *shape_price;
                         (balance, functions, None, None, None, *fade, *instant)
                     }
                     _ => return None,

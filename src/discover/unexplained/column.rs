@@ -48,7 +48,7 @@ impl Column {
 
     pub fn fade(&self) -> Option<f64> {
         match self.shape {
-            Shape::Fade(tau) => Some(tau),
+            Shape::Fade(f) => Some(f.tau),
             _ => None,
         }
     }
@@ -67,6 +67,7 @@ impl Column {
             Shape::Harmonic(h) => h.price,
             Shape::Spot(s) => s.price,
             Shape::Step(s) => s.price,
+            Shape::Fade(f) => f.price,
             _ => 0.0,
         }
     }
@@ -109,10 +110,46 @@ pub(super) enum Shape {
     Harmonic(Harmonic),
     CurrentLimit(f64),
     Spot(SpotShape),
-    /// The time constant τ of exp(−t/τ).
-    Fade(f64),
+    /// The time constant τ of exp(−t/τ), and what its search cost (ln G).
+    Fade(FadeShape),
     /// The instant of step(t − t_s), and what its search cost (ln G).
     Step(StepShape),
+}
+
+/// A fade's time constant offered, and what finding it cost (ln G over the grid; nothing for
+/// the model's own law's τ, paid for where it was found).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct FadeShape {
+    pub tau: f64,
+    pub price: f64,
+}
+
+/// The fade column of `columns` offered where `offered` allows it whose gain on `y`,
+/// ½·(b̃·y)²/(b̃·b̃) of its column of `b_tilde`, is largest: its τ. A fade is offered at that τ
+/// alone, as one move paying its grid's ln G, as a spot of the angle or a step is
+/// (`spot`, `reading_step`).
+pub(super) fn best_fade(
+    columns: &[Column],
+    b_tilde: &nalgebra::DMatrix<f64>,
+    y: &nalgebra::DVector<f64>,
+    offered: impl Fn(&Column) -> bool,
+) -> Option<f64> {
+    let mut best: Option<(f64, f64)> = None;
+    for (j, c) in columns.iter().enumerate() {
+        let Some(tau) = c.fade().filter(|_| offered(c)) else {
+            continue;
+        };
+        let b = b_tilde.column(j);
+        let bb = b.norm_squared();
+        if bb <= 0.0 {
+            continue;
+        }
+        let gain = 0.5 * b.dot(y).powi(2) / bb;
+        if best.is_none_or(|(g, _)| gain > g) {
+            best = Some((gain, tau));
+        }
+    }
+    best.map(|(_, tau)| tau)
 }
 
 /// A step's instant offered, and what finding it cost (ln G over the instants tried).

@@ -100,10 +100,10 @@ pub enum Fingerprint {
         /// The instant t_s [s] of `step(t-t_s)`, where it is one of the functions.
         #[serde(rename = "t_s", skip_serializing_if = "Option::is_none")]
         instant: Option<f64>,
-        /// What finding its instant cost (ln G over the instants tried, else 0): a law named
-        /// with it pays it too.
+        /// What finding its shape cost (ln G over a step's instants or a fade's time
+        /// constants, else 0): a law named with it pays it too.
         #[serde(skip)]
-        instant_price: f64,
+        shape_price: f64,
         score: f64,
     },
     Unknown {

@@ -11,7 +11,7 @@ use crate::motor::dictionary::{
 };
 
 use super::super::candidate::Candidate;
-use super::state::{Column, Harmonic, Shape, select};
+use super::state::{Column, FadeShape, Harmonic, Shape, best_fade, select};
 use super::{Context, Evidence};
 
 /// The functions a measured channel is offered in (`measurement:I`, `measurement:omega`): a
@@ -133,7 +133,16 @@ pub(super) fn fingerprints(
         }
         // A zero that settles (a sensor warming up, its offset fading).
         if fresh(FADE) {
-            columns.extend(fades.iter().map(|&tau| Column::new(FADE, Shape::Fade(tau))));
+            let price = if fades.len() > 1 {
+                (fades.len() as f64).ln()
+            } else {
+                0.0
+            };
+            columns.extend(
+                fades
+                    .iter()
+                    .map(|&tau| Column::new(FADE, Shape::Fade(FadeShape { tau, price }))),
+            );
         }
         // The angle's ripple each reading is offered: ω's scaled by the speed, I's alone.
         let ripple = if Some(c) == speed {
@@ -173,13 +182,15 @@ pub(super) fn fingerprints(
             }
         }
         let b_tilde = ctx.projector.residualize(&b);
+        // One fade, the best τ of the grid for this channel.
+        let fade = best_fade(&columns, &b_tilde, &ctx.y, |_: &Column| true);
         out.extend(select(
             ctx,
             &columns,
             &b_tilde,
             &balance,
             shift,
-            |_: &Column| true,
+            |c: &Column| c.fade().is_none() || c.fade() == fade,
         ));
     }
     // And a change at an instant on each channel read, a move of its own (its search paid by

@@ -52,7 +52,7 @@ use crate::motor::{ActiveTerm, MotorModel, Term};
 
 use super::super::candidate::Candidate;
 use super::super::settings::EVIDENCE_THRESHOLD;
-pub(super) use super::column::{Column, Harmonic, Shape};
+pub(super) use super::column::{Column, FadeShape, Harmonic, Shape, best_fade};
 use super::fingerprint::LawFunction;
 use super::regression::{coefficient_sds, explain, gain};
 use super::{Context, Evidence, Fingerprint};
@@ -68,8 +68,13 @@ const CURRENT_LIMIT_SHARES: [f64; 6] = [0.5, 0.6, 0.7, 0.8, 0.9, 0.95];
 /// The fade's time constants tried (`dictionary::FADE`): the record's duration halved, and
 /// halved again while at least two sample intervals (a faster fade is over before the second
 /// sample). Halving keeps exp(−t/τ)'s column near its neighbours' (its correlation with the
-/// column at 2τ is 0.94 over a long record), as the Stribeck grid's doubling does, and each
-/// value is one more column tried, paid for by the step's look-elsewhere.
+/// column at 2τ is 0.94 over a long record), as the Stribeck grid's doubling does. The best τ
+/// of a balance is offered as one move paying ln G (`column::best_fade`), as a spot or a step
+/// pays its grid: offered as seven columns, each paying only the step's look-elsewhere, the fade
+/// had seven tries at the noise where a function of the state has one, and on a spin-up, whose
+/// current falls about as exp(−t/τ_m), it took four laws of the state by 2 nats or less
+/// (bearing_defect-770006, dead_time-900009, flux_saturation-680011, load_friction-510021:
+/// papers/beyond-library.md, session 31).
 pub(super) fn fade_grid(duration: f64, interval: f64) -> Vec<f64> {
     (1..)
         .map(|j| duration / 2f64.powi(j))
@@ -151,7 +156,7 @@ fn law_columns(
         Shape::Harmonic(h) => shapes.harmonic = h.k,
         Shape::CurrentLimit(i) => shapes.current_limit = i,
         Shape::Spot(s) => (shapes.spot_angle, shapes.spot_width) = (s.spot.theta_0, s.spot.w),
-        Shape::Fade(tau) => shapes.fade = tau,
+        Shape::Fade(f) => shapes.fade = f.tau,
         Shape::Step(s) => shapes.instant = s.t_s,
     }
     let mut shaped = law.clone().with_active(active);
@@ -317,8 +322,15 @@ pub(super) fn fingerprints(
     for &i in &current_limits {
         add(vec![CURRENT_LIMIT], Shape::CurrentLimit(i))?;
     }
+    // The grid's τ pay ln G; the model's own law's τ was paid for where it was found.
+    let fade_price = if fades.len() > 1 {
+        (fades.len() as f64).ln()
+    } else {
+        0.0
+    };
     for &tau in &fades {
-        add(vec![FADE], Shape::Fade(tau))?;
+        let price = fade_price;
+        add(vec![FADE], Shape::Fade(FadeShape { tau, price }))?;
     }
     let mut out = Vec::new();
     for balance in 0..ODE_BALANCES {
@@ -341,11 +353,14 @@ pub(super) fn fingerprints(
                 .filter(|&&k| k / N_FUNCTIONS == balance)
                 .find_map(|&k| ripple_of(k % N_FUNCTIONS))
         });
-        let offered = |c: &Column| {
+        let offered_here = |c: &Column| {
             let f = c.function;
             dictionary::offered_in(f, balance)
                 && ripple_of(f).is_none_or(|r| own_ripple.is_none_or(|o| o == r))
         };
+        // One fade, the best τ of the grid for this balance.
+        let fade = best_fade(&columns, &b_tilde, &ctx.y, offered_here);
+        let offered = |c: &Column| offered_here(c) && (c.fade().is_none() || c.fade() == fade);
         let first = select(ctx, &columns, &b_tilde, name, shift, offered);
         // A ripple in the angle on its own as well, where the selection took another
         // function first: on a record that spins up from rest the ripple's net early push is
@@ -362,7 +377,7 @@ pub(super) fn fingerprints(
         // revolution, I·cos(6θ) taken); the fits decide, as above.
         let searched = columns
             .iter()
-            .find(|c| c.price() > 0.0)
+            .find(|c| c.harmonic().is_some() && c.price() > 0.0)
             .and_then(|c| c.harmonic());
         let took_searched = |e: &Evidence| match &e.fingerprint {
             Fingerprint::State { harmonic, .. } => *harmonic == searched,
@@ -451,9 +466,13 @@ pub(super) fn select(
                 let mut set = chosen.clone();
                 set.extend(m);
                 let g = gain(&ctx.y, &b_tilde.select_columns(&set));
-                // A searched order is paid for once, by the move that first takes it.
-                let searched = m.iter().map(|&j| columns[j].price()).fold(0.0, f64::max);
-                let searched = if harmonic.is_none() { searched } else { 0.0 };
+                // A searched order is paid for once, by the move that first takes it; a fade's
+                // τ, a step's instant or a spot by the move that takes it (one of each at most).
+                let searched = m
+                    .iter()
+                    .filter(|&&j| harmonic.is_none() || columns[j].harmonic().is_none())
+                    .map(|&j| columns[j].price())
+                    .fold(0.0, f64::max);
                 let price = 0.5 * ctx.ln_n * m.len() as f64 + look_elsewhere + searched;
                 (m, g, g - current - price)
             })
@@ -495,7 +514,7 @@ pub(super) fn select(
             functions,
             fade,
             instant: chosen.iter().find_map(|&j| columns[j].instant()),
-            instant_price: chosen
+            shape_price: chosen
                 .iter()
                 .map(|&j| columns[j].price())
                 .fold(0.0, f64::max),

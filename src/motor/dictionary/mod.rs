@@ -142,8 +142,8 @@ pub const READING_RIPPLE: [usize; 2] = [OMEGA_SIN_THETA, OMEGA_COS_THETA];
 /// coefficient and its search over θ₀ and w (`unexplained::spot`).
 pub const OMEGA_SPOT: usize = 29;
 
-/// A change with time that settles, exp(−t/τ) from the record's start (τ a shape, searched as
-/// ω_s is): a holding brake still releasing, a supply or a sensor's zero settling after
+/// A change with time that settles, exp(−t/τ) from the record's start (τ a shape, searched over
+/// a grid, `unexplained::state::fade_grid`): a holding brake still releasing, a supply or a sensor's zero settling after
 /// switch-on. `t` alone, the only other function of time, is a change that goes on at one
 /// rate; a change that settles within the record was named by whatever state variable moves
 /// with it there (on a spin-up, the speed's Stribeck hump: brake_release-910006 and -910014,
