@@ -324,6 +324,7 @@ fn the_dictionary_at_one_point_gives_each_shared_factor_its_own_formula_in_any_o
         spot_angle: 2.4,
         spot_width: 0.3,
         fade: 0.05,
+        instant: 0.25,
     };
     // A direction through every state at once, so a factor taken for another one shows.
     let x = Point {
