@@ -61,14 +61,15 @@ const SPEED: usize = 0;
 /// to what is read, not to a balance: the column is the function itself, no solve needed),
 /// selected as a balance's are; the law's measurement balances hold them, so a fingerprint
 /// here names a law as a balance's does (`named`). The current is also offered beyond each of
-/// `current_limits` (`sign(I)*max(|I|-I_lim,0)`), and a fade at each of `fades` (a zero
-/// settling after switch-on, exp(−t/τ)): a reading clipped at its sensor's or its
+/// `current_limits` (`sign(I)*max(|I|-I_lim,0)`): a reading clipped at its sensor's or its
 /// converter's range is I less that, which in the voltage balance would be a drive's limit
 /// acting on the motor — the two told apart by ω, which the clip leaves alone. The speed is
 /// also offered times the angle's ripple at each of `harmonics` (θ the predicted speed's
 /// integral from the record's start, as the law's own state is), its sine and cosine one move
 /// as a balance's ripples are; and a spot of the angle on ω (`spot`), the record turning
-/// `per_sample` radians between samples at its speed scale.
+/// `per_sample` radians between samples at its speed scale. Each channel is also offered a
+/// fade at the best of `fades` (a zero settling after switch-on, exp(−t/τ), paying ln G over
+/// them) and a change at an instant (`reading_step`).
 pub(super) fn fingerprints(
     fit: &Candidate,
     ctx: &Context,
