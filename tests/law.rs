@@ -293,6 +293,9 @@ fn a_spot_without_a_width_or_an_angle_is_refused_naming_the_file_line_and_settin
     for (setting, why) in [
         ("w = 0.0", "law.w = 0 must be a positive number"),
         ("theta_0 = nan", "law.theta_0 must be a finite number"),
+        // The fade's time constant and the step's instant (session 31) the same way.
+        ("tau = -0.01", "law.tau = -0.01 must be a positive number"),
+        ("t_s = inf", "law.t_s must be a finite number"),
     ] {
         std::fs::write(
             &path,

@@ -4,6 +4,7 @@
 
 use crate::motor::dictionary::Spot;
 
+use super::regression::best_single_column;
 use super::spot::SpotShape;
 
 /// A column of the regression: a function (dictionary index) and the shape it has, the
@@ -124,6 +125,19 @@ pub(super) struct FadeShape {
     pub price: f64,
 }
 
+impl FadeShape {
+    /// The fades offered at `taus`: a grid's each paying ln G, the model's own law's one τ
+    /// nothing (paid for where it was found).
+    pub fn at(taus: &[f64]) -> Vec<FadeShape> {
+        let price = if taus.len() > 1 {
+            (taus.len() as f64).ln()
+        } else {
+            0.0
+        };
+        taus.iter().map(|&tau| FadeShape { tau, price }).collect()
+    }
+}
+
 /// The fade column of `columns` offered where `offered` allows it whose gain on `y`,
 /// ½·(b̃·y)²/(b̃·b̃) of its column of `b_tilde`, is largest: its τ. A fade is offered at that τ
 /// alone, as one move paying its grid's ln G, as a spot of the angle or a step is
@@ -134,22 +148,8 @@ pub(super) fn best_fade(
     y: &nalgebra::DVector<f64>,
     offered: impl Fn(&Column) -> bool,
 ) -> Option<f64> {
-    let mut best: Option<(f64, f64)> = None;
-    for (j, c) in columns.iter().enumerate() {
-        let Some(tau) = c.fade().filter(|_| offered(c)) else {
-            continue;
-        };
-        let b = b_tilde.column(j);
-        let bb = b.norm_squared();
-        if bb <= 0.0 {
-            continue;
-        }
-        let gain = 0.5 * b.dot(y).powi(2) / bb;
-        if best.is_none_or(|(g, _)| gain > g) {
-            best = Some((gain, tau));
-        }
-    }
-    best.map(|(_, tau)| tau)
+    let fade = |j: usize| columns[j].fade().is_some() && offered(&columns[j]);
+    best_single_column(b_tilde, y, fade).and_then(|(_, j)| columns[j].fade())
 }
 
 /// A step's instant offered, and what finding it cost (ln G over the instants tried).

@@ -134,15 +134,10 @@ pub(super) fn fingerprints(
         }
         // A zero that settles (a sensor warming up, its offset fading).
         if fresh(FADE) {
-            let price = if fades.len() > 1 {
-                (fades.len() as f64).ln()
-            } else {
-                0.0
-            };
             columns.extend(
-                fades
-                    .iter()
-                    .map(|&tau| Column::new(FADE, Shape::Fade(FadeShape { tau, price }))),
+                FadeShape::at(fades)
+                    .into_iter()
+                    .map(|f| Column::new(FADE, Shape::Fade(f))),
             );
         }
         // The angle's ripple each reading is offered: ω's scaled by the speed, I's alone.

@@ -14,9 +14,10 @@
 //! the largest of 497 gains of ½χ²₁ (neighbours' gains strongly correlated, so fewer
 //! independent ones) clears it with probability below 497·P(χ²₁ > 23.3) ≈ 0.07% per channel.
 
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DMatrix;
 
 use super::column::StepShape;
+use super::regression::best_single_column;
 use super::state::{Column, Shape, select};
 use super::{Context, Evidence};
 use crate::motor::dictionary::STEP;
@@ -35,7 +36,7 @@ pub(super) fn fingerprints(ctx: &Context, c: usize, balance: &str, shift: f64) -
     let b_tilde = ctx
         .projector
         .residualize(&steps(ctx.m(), n, c, ctx.sigma[c], &instants));
-    let Some((_, j)) = best(&b_tilde, &ctx.y) else {
+    let Some((_, j)) = best_single_column(&b_tilde, &ctx.y, |_| true) else {
         return Vec::new();
     };
     let shape = StepShape {
@@ -63,28 +64,11 @@ fn steps(m: usize, n: usize, c: usize, sigma: f64, instants: &[usize]) -> DMatri
     b
 }
 
-/// The column of `b` whose gain on `y`, ½·(b·y)²/(b·b), is largest, with that gain; the
-/// first of equals, so that the same record gives the same instant.
-fn best(b: &DMatrix<f64>, y: &DVector<f64>) -> Option<(f64, usize)> {
-    let mut best: Option<(f64, usize)> = None;
-    for j in 0..b.ncols() {
-        let column = b.column(j);
-        let bb = column.norm_squared();
-        if bb <= 0.0 {
-            continue;
-        }
-        let gain = 0.5 * column.dot(y).powi(2) / bb;
-        if best.is_none_or(|(g, _)| gain > g) {
-            best = Some((gain, j));
-        }
-    }
-    best
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::discover::settings::EVIDENCE_THRESHOLD;
+    use nalgebra::DVector;
     use rand::SeedableRng;
     use rand_distr::{Distribution, Normal};
 
@@ -110,7 +94,10 @@ mod tests {
         let instants: Vec<usize> = (MARGIN..=N - MARGIN).collect();
         let b = steps(2 * N, N, 0, 1.0, &instants);
         let alarms: Vec<u64> = (0..200)
-            .filter(|&seed| best(&b, &noise(seed)).is_some_and(|(g, _)| g > bar(instants.len())))
+            .filter(|&seed| {
+                best_single_column(&b, &noise(seed), |_| true)
+                    .is_some_and(|(g, _)| g > bar(instants.len()))
+            })
             .collect();
         assert!(
             alarms.is_empty(),
@@ -132,7 +119,7 @@ mod tests {
             for i in 310..N {
                 y[N + i] += 1.2;
             }
-            let (gain, j) = best(&b, &y).unwrap();
+            let (gain, j) = best_single_column(&b, &y, |_| true).unwrap();
             assert!(gain > bar(instants.len()), "seed {seed}: gain {gain}");
             near += usize::from(instants[j].abs_diff(310) <= 10);
         }

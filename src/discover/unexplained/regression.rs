@@ -137,6 +137,30 @@ pub fn golden_max(lo: f64, hi: f64, steps: usize, mut g: impl FnMut(f64) -> f64)
 /// The best of `gain` on the grid lo, lo + step, … ≤ hi, refined by golden section between
 /// its neighbours (within [lo, hi]), and the grid's size G (a setting found this way pays
 /// ln G): the order search's and the reading's step search's one pattern. None on an empty
+/// The column of `b` (among those `offered`) whose gain alone on `y`, ½·(b·y)²/(b·b), is
+/// largest, with that gain; the first of equals, so that the same record gives the same
+/// column. A shape searched over a grid (a spot of the angle, a step's instant, a fade's τ) is
+/// offered at that column alone, paying ln G for the search.
+pub fn best_single_column(
+    b: &DMatrix<f64>,
+    y: &DVector<f64>,
+    offered: impl Fn(usize) -> bool,
+) -> Option<(f64, usize)> {
+    let mut best: Option<(f64, usize)> = None;
+    for j in (0..b.ncols()).filter(|&j| offered(j)) {
+        let column = b.column(j);
+        let bb = column.norm_squared();
+        if bb <= 0.0 {
+            continue;
+        }
+        let gain = 0.5 * column.dot(y).powi(2) / bb;
+        if best.is_none_or(|(g, _)| gain > g) {
+            best = Some((gain, j));
+        }
+    }
+    best
+}
+
 /// grid.
 pub fn grid_peak(lo: f64, hi: f64, step: f64, gain: impl Fn(f64) -> f64) -> Option<(f64, usize)> {
     let grid: Vec<f64> = (0..)

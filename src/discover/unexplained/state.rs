@@ -322,15 +322,8 @@ pub(super) fn fingerprints(
     for &i in &current_limits {
         add(vec![CURRENT_LIMIT], Shape::CurrentLimit(i))?;
     }
-    // The grid's τ pay ln G; the model's own law's τ was paid for where it was found.
-    let fade_price = if fades.len() > 1 {
-        (fades.len() as f64).ln()
-    } else {
-        0.0
-    };
-    for &tau in &fades {
-        let price = fade_price;
-        add(vec![FADE], Shape::Fade(FadeShape { tau, price }))?;
+    for fade in FadeShape::at(&fades) {
+        add(vec![FADE], Shape::Fade(fade))?;
     }
     let mut out = Vec::new();
     for balance in 0..ODE_BALANCES {
