@@ -4,9 +4,12 @@
 # changes touch; prints each case's runtime_s from its report. From the root.
 set -e
 T=${T:-/tmp/s30/b}; O=$T/timing; mkdir -p $O
-for N in h81/sensor_dropout-810003 h76/gear_ripple-760017 h77/cogging-770012 h76/bearing_defect-760002 \
-         h68/resonant_sensor-680020 h78/clutch_engagement-780007 h78/clutch_engagement-780012 \
-         h90/loose_part-900004 h90/ac_coupled_tacho-900015 h79/pump_threshold-790010; do
+# CASES (SET/CASE …) and T may be set by the caller (session 31's timing.sh); these are session 30's.
+CASES=${CASES:-"h81/sensor_dropout-810003 h76/gear_ripple-760017 h77/cogging-770012
+  h76/bearing_defect-760002 h68/resonant_sensor-680020 h78/clutch_engagement-780007
+  h78/clutch_engagement-780012 h90/loose_part-900004 h90/ac_coupled_tacho-900015
+  h79/pump_threshold-790010"}
+for N in $CASES; do
   C=$T/cases/$N; n=$(basename $N)
   for V in head:$HEAD new:$NEW; do
     ${V#*:} diagnose --quiet --data $C/recording.csv --model $C/motor.toml --json $O/$n-${V%%:*}.json --out $O/$n-${V%%:*}.d > /dev/null 2>&1 || true
