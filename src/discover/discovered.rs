@@ -8,12 +8,14 @@ use serde::Serialize;
 
 use crate::motor::Term;
 use crate::motor::dictionary::{
-    self, BALANCES, CURRENT_LIMIT, FADE, FUNCTIONS, N_FUNCTIONS, OMEGA_SPOT, STEP, STRIBECK, Spot,
-    reads_harmonic,
+    self, BALANCES, CURRENT_LIMIT, FADE, FUNCTIONS, N_FUNCTIONS, OMEGA_SPOT, SPEED_LIMIT, STEP,
+    STRIBECK, Spot, reads_harmonic,
 };
 
 use super::candidate::Candidate;
-use super::unexplained::{EquationTerm, equation_with, with_shapes, with_spot, with_time};
+use super::unexplained::{
+    EquationTerm, equation_with, with_shapes, with_speed_limit, with_spot, with_time,
+};
 
 /// One function of a discovered law: its coefficient at the MAP and the 95% interval of the
 /// Laplace approximation there (MAP ± 1.96 sd; the coefficients have real support, so the
@@ -42,6 +44,10 @@ pub struct Discovered {
     /// The current limit I_lim [A], where the law holds `sign(I)*max(|I|-I_lim,0)`.
     #[serde(rename = "I_lim", skip_serializing_if = "Option::is_none")]
     pub current_limit: Option<f64>,
+    /// The speed limit ω_lim [rad/s], where the law holds
+    /// `sign(omega)*max(|omega|-omega_lim,0)`.
+    #[serde(rename = "omega_lim", skip_serializing_if = "Option::is_none")]
+    pub speed_limit: Option<f64>,
     /// The frequency f [Hz] of a periodic law, where it holds sin or cos(2πft).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub frequency_hz: Option<f64>,
@@ -121,6 +127,7 @@ pub fn discovered(fit: &Candidate, gained: f64) -> Option<Discovered> {
         .any(|f| dictionary::reads_frequency(f) && holds(f))
         .then_some(law.shapes.frequency);
     let current_limit = holds(CURRENT_LIMIT).then_some(law.shapes.current_limit);
+    let speed_limit = holds(SPEED_LIMIT).then_some(law.shapes.speed_limit);
     let spot = holds(OMEGA_SPOT).then(|| Spot::of(&law.shapes));
     let fade = holds(FADE).then_some(law.shapes.fade);
     let instant = holds(STEP).then_some(law.shapes.instant);
@@ -132,6 +139,7 @@ pub fn discovered(fit: &Candidate, gained: f64) -> Option<Discovered> {
         omega_s,
         k,
         current_limit,
+        speed_limit,
         frequency_hz,
         balance,
         functions,
@@ -149,18 +157,21 @@ impl Discovered {
                 .iter()
                 .map(|f| (f.name.clone(), f.coefficient, Some((f.q025, f.q975))))
                 .collect();
-            with_time(
-                with_spot(
-                    with_shapes(
-                        equation_with(balance, &terms),
-                        self.k,
-                        self.current_limit,
-                        self.frequency_hz,
+            with_speed_limit(
+                with_time(
+                    with_spot(
+                        with_shapes(
+                            equation_with(balance, &terms),
+                            self.k,
+                            self.current_limit,
+                            self.frequency_hz,
+                        ),
+                        self.spot,
                     ),
-                    self.spot,
+                    self.fade,
+                    self.instant,
                 ),
-                self.fade,
-                self.instant,
+                self.speed_limit,
             )
         };
         let mut equation = one(&self.balance, &self.functions);

@@ -357,6 +357,13 @@ pub fn named_term(problem: &Problem, fingerprint: &Fingerprint) -> Option<NamedT
             if let Some(t_s) = instant {
                 law.shapes.instant = t_s;
             }
+            if let Fingerprint::State {
+                speed_limit: Some(w),
+                ..
+            } = fingerprint
+            {
+                law.shapes.speed_limit = *w;
+            }
             if let Fingerprint::State { spot: Some(p), .. } = fingerprint {
                 (law.shapes.spot_angle, law.shapes.spot_width) = (p.theta_0, p.w);
             }

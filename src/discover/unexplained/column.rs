@@ -1,6 +1,6 @@
 //! The columns a state fingerprint's selection is offered: a dictionary function and the shape
 //! it is evaluated at (the Stribeck speed, the angle's harmonic, the current limit, a spot of
-//! the angle), with what finding that shape cost.
+//! the angle, a fade's time constant, the speed limit), with what finding that shape cost.
 
 use crate::motor::dictionary::Spot;
 
@@ -8,7 +8,8 @@ use super::regression::best_single_column;
 use super::spot::SpotShape;
 
 /// A column of the regression: a function (dictionary index) and the shape it has, the
-/// Stribeck speed, the angle's harmonic, the current limit, a spot of the angle or a fade's time constant.
+/// Stribeck speed, the angle's harmonic, the current limit, a spot of the angle, a fade's time
+/// constant or the speed limit.
 pub(super) struct Column {
     pub function: usize,
     pub shape: Shape,
@@ -49,7 +50,14 @@ impl Column {
 
     pub fn fade(&self) -> Option<f64> {
         match self.shape {
-            Shape::Fade(f) => Some(f.tau),
+            Shape::Fade(f) => Some(f.value),
+            _ => None,
+        }
+    }
+
+    pub fn speed_limit(&self) -> Option<f64> {
+        match self.shape {
+            Shape::SpeedLimit(l) => Some(l.value),
             _ => None,
         }
     }
@@ -68,7 +76,7 @@ impl Column {
             Shape::Harmonic(h) => h.price,
             Shape::Spot(s) => s.price,
             Shape::Step(s) => s.price,
-            Shape::Fade(f) => f.price,
+            Shape::Fade(f) | Shape::SpeedLimit(f) => f.price,
             _ => 0.0,
         }
     }
@@ -112,44 +120,50 @@ pub(super) enum Shape {
     CurrentLimit(f64),
     Spot(SpotShape),
     /// The time constant τ of exp(−t/τ), and what its search cost (ln G).
-    Fade(FadeShape),
+    Fade(OnGrid),
+    /// The speed limit ω_lim of what is read of ω, and what its search cost (ln G).
+    SpeedLimit(OnGrid),
     /// The instant of step(t − t_s), and what its search cost (ln G).
     Step(StepShape),
 }
 
-/// A fade's time constant offered, and what finding it cost (ln G over the grid; nothing for
-/// the model's own law's τ, paid for where it was found).
+/// A shape's value offered from a grid (a fade's τ, a speed limit), and what finding it cost
+/// (ln G over the grid; nothing for the model's own law's value, paid for where it was found).
 #[derive(Clone, Copy, Debug)]
-pub(super) struct FadeShape {
-    pub tau: f64,
+pub(super) struct OnGrid {
+    pub value: f64,
     pub price: f64,
 }
 
-impl FadeShape {
-    /// The fades offered at `taus`: a grid's each paying ln G, the model's own law's one τ
-    /// nothing (paid for where it was found).
-    pub fn at(taus: &[f64]) -> Vec<FadeShape> {
-        let price = if taus.len() > 1 {
-            (taus.len() as f64).ln()
+impl OnGrid {
+    /// The shapes offered at `values`: a grid's each paying ln G, the model's own law's one
+    /// value nothing (paid for where it was found).
+    pub fn at(values: &[f64]) -> Vec<OnGrid> {
+        let price = if values.len() > 1 {
+            (values.len() as f64).ln()
         } else {
             0.0
         };
-        taus.iter().map(|&tau| FadeShape { tau, price }).collect()
+        values
+            .iter()
+            .map(|&value| OnGrid { value, price })
+            .collect()
     }
 }
 
-/// The fade column of `columns` offered where `offered` allows it whose gain on `y`,
-/// ½·(b̃·y)²/(b̃·b̃) of its column of `b_tilde`, is largest: its τ. A fade is offered at that τ
-/// alone, as one move paying its grid's ln G, as a spot of the angle or a step is
-/// (`spot`, `reading_step`).
-pub(super) fn best_fade(
+/// The column of `columns` with the shape `shape` reads (a fade's τ, a speed limit), offered
+/// where `offered` allows it, whose gain on `y`, ½·(b̃·y)²/(b̃·b̃) of its column of `b_tilde`,
+/// is largest: its shape's value. Such a shape is offered at that value alone, as one move
+/// paying its grid's ln G, as a spot of the angle or a step is (`spot`, `reading_step`).
+pub(super) fn best_on_grid(
     columns: &[Column],
     b_tilde: &nalgebra::DMatrix<f64>,
     y: &nalgebra::DVector<f64>,
+    shape: impl Fn(&Column) -> Option<f64>,
     offered: impl Fn(&Column) -> bool,
 ) -> Option<f64> {
-    let fade = |j: usize| columns[j].fade().is_some() && offered(&columns[j]);
-    best_single_column(b_tilde, y, fade).and_then(|(_, j)| columns[j].fade())
+    let member = |j: usize| shape(&columns[j]).is_some() && offered(&columns[j]);
+    best_single_column(b_tilde, y, member).and_then(|(_, j)| shape(&columns[j]))
 }
 
 /// A step's instant offered, and what finding it cost (ln G over the instants tried).

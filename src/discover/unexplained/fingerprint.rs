@@ -64,6 +64,10 @@ pub enum Fingerprint {
         /// functions.
         #[serde(rename = "I_lim", skip_serializing_if = "Option::is_none")]
         current_limit: Option<f64>,
+        /// The speed limit ω_lim [rad/s] of `sign(omega)*max(|omega|-omega_lim,0)`, where it
+        /// is one of the functions.
+        #[serde(rename = "omega_lim", skip_serializing_if = "Option::is_none")]
+        speed_limit: Option<f64>,
         /// The spot's θ₀ and w of `omega*exp(-2*(1-cos(theta-theta_0))/w^2)`, where it is
         /// one of the functions (`theta_0`, `w` in the JSON).
         #[serde(flatten, skip_serializing_if = "Option::is_none")]
@@ -121,6 +125,7 @@ impl Fingerprint {
             omega_s: None,
             harmonic: None,
             current_limit: None,
+            speed_limit: None,
             spot: None,
             fade: None,
             instant: None,
@@ -182,6 +187,10 @@ impl Fingerprint {
 
     /// What a user might do about it, in a sentence.
     pub fn suggestion(&self, channels: &[String]) -> String {
+        let speed_limit = match self {
+            Fingerprint::State { speed_limit, .. } => *speed_limit,
+            _ => None,
+        };
         match self {
             Fingerprint::Oscillation {
                 frequency_hz,
@@ -277,7 +286,10 @@ impl Fingerprint {
                  sensor), reads nonlinearly, clips at its range or drifts (the term law, in \
                  what is read)",
                 balance.trim_start_matches("measurement:"),
-                with_time(equation(balance, functions), *fade, *instant)
+                with_speed_limit(
+                    with_time(equation(balance, functions), *fade, *instant),
+                    speed_limit
+                )
             ),
             Fingerprint::State {
                 balance,
@@ -368,6 +380,14 @@ pub fn with_shapes(
         equation = equation.replace("2πft", &format!("2π·{f:.2}·t"));
     }
     equation
+}
+
+/// A speed limit written into its equation: `max(|ω|-2350.0 rad/s,0)` for ω_lim = 2350 rad/s.
+pub fn with_speed_limit(equation: String, speed_limit: Option<f64>) -> String {
+    match speed_limit {
+        Some(w) => equation.replace("ω_lim", &format!("{w:.1} rad/s")),
+        None => equation,
+    }
 }
 
 /// A spot's shape written into its equation: `exp(-2·(1-cos(θ-2.356))/0.196^2)` for θ₀ =

@@ -93,6 +93,7 @@ pub(super) fn evidence(ctx: &Context, c: usize, shift: f64) -> Option<Evidence> 
             omega_s: None,
             harmonic: None,
             current_limit: None,
+            speed_limit: None,
             spot: None,
             fade: None,
             instant: None,

@@ -6,12 +6,12 @@ use nalgebra::DMatrix;
 
 use crate::motor::Term;
 use crate::motor::dictionary::{
-    self, CONSTANT, CURRENT_LIMIT, FADE, N_FUNCTIONS, OMEGA_SPOT, Point, READING_RIPPLE, RIPPLES,
-    STEP, Shapes, THETA,
+    self, CONSTANT, CURRENT_LIMIT, FADE, HEAT, I_HEAT, N_FUNCTIONS, OMEGA_SPOT, Point,
+    READING_RIPPLE, RIPPLES, SPEED_LIMIT, STEP, Shapes, THETA,
 };
 
 use super::super::candidate::Candidate;
-use super::state::{Column, FadeShape, Harmonic, Shape, best_fade, select};
+use super::state::{Column, Harmonic, OnGrid, Shape, best_on_grid, select};
 use super::{Context, Evidence};
 
 /// The functions a measured channel is offered in (`measurement:I`, `measurement:omega`): a
@@ -46,15 +46,34 @@ use super::{Context, Evidence};
 /// wherever the speed is not steady (the start, a reversal). Without it, such a reading was
 /// named a drift in time in the voltage balance. One column more on ω raises its first's price
 /// by ln(9/8), 0.12 nats.
-const MEASURED: [usize; 9] = [0, 1, 2, 5, 7, 9, 12, CONSTANT, THETA];
+///
+/// The current's reading is offered the heat the winding has drawn, E = ∫R·I² dt of the
+/// predicted current (as the law's own state is), alone and times I: a shunt or a Hall cell in
+/// the winding's circuit warms with the same I², and a reading whose zero drifts with its
+/// temperature reads heat, one whose gain drifts reads I·heat. Before, a gain drifting so
+/// (sensor_gain_heat-920003 to -920015, session 31's fifteenth set) was named a law in I and a
+/// fade, or `unknown`. Offered on I only: a speed sensor sits on the shaft, not in the
+/// current's circuit. Two columns more on I raise its first's price by ln(10/8), 0.22 nats.
+const MEASURED: [usize; 11] = [0, 1, 2, 5, 7, 9, 12, CONSTANT, THETA, HEAT, I_HEAT];
 /// The input, offered where it varies.
 const INPUT: usize = 9;
 /// Those of them that read the speed (`omega`, `omega*|omega|`, `omega^3`, `theta`), and the
 /// current (`I`, `I*|I|`): offered only on that channel's own reading.
 const READS_SPEED: [usize; 4] = [0, 1, 2, THETA];
-const READS_CURRENT: [usize; 2] = [5, 7];
+const READS_CURRENT: [usize; 4] = [5, 7, HEAT, I_HEAT];
 /// The speed itself read on the speed's channel: a gain, the library's `speed_gain`.
 const SPEED: usize = 0;
+
+/// The speed limits ω_lim tried in what is read of ω, the gap below the predicted peak speed
+/// halved from half the peak seven times (50% down to 0.8% below it), fixed before any record
+/// was scored with them. A clip acts where the speed is above it; on a spin-up the speed nears
+/// its top as exp(−t/τ_m), so the time it spends above a level grows with the logarithm of
+/// that level's gap to the top, and halving the gap spaces the columns evenly in that time.
+/// The last, 0.8% below the peak, is reached after ln 128 ≈ 4.9 mechanical time constants,
+/// half of a record of ten: a clip nearer the top acts on the record's last part alone, as
+/// that column does. The best of them is offered alone, one move paying ln 7
+/// (`column::best_on_grid`), as a fade's τ is.
+const SPEED_LIMIT_GAPS: [f64; 7] = [0.5, 0.25, 0.125, 0.0625, 0.03125, 0.015625, 0.0078125];
 
 /// The state fingerprints of the measured channels: the residual of a channel regressed on
 /// functions of the predicted state and the input in that channel alone (a measurement adds
@@ -100,8 +119,20 @@ pub(super) fn fingerprints(
         })
         .unwrap_or_default();
     let input_varies = !model.input.breakpoints().is_empty();
-    // The angle, once for both channels (ω's ripple reads it).
+    // The angle, once for both channels (ω's ripple reads it), and the heat drawn (I's).
     let theta = ctx.angle().unwrap_or_else(|| vec![0.0; ctx.n]);
+    let resistance = fit
+        .theta
+        .get("R")
+        .copied()
+        .unwrap_or(model.nominal.resistance);
+    let heat = current.map_or_else(
+        || vec![0.0; ctx.n],
+        |k| {
+            ctx.fine
+                .integral_of_at(k, |i| resistance * i * i, &ctx.times)
+        },
+    );
     let mut out = Vec::new();
     for (c, channel) in ctx.channels.iter().enumerate() {
         if Some(c) != current && Some(c) != speed {
@@ -132,10 +163,24 @@ pub(super) fn fingerprints(
                     .map(|&i| Column::new(CURRENT_LIMIT, Shape::CurrentLimit(i))),
             );
         }
+        // A reading clipped at the top of its range (ω's; the current's is the hinge above).
+        if Some(c) == speed && fresh(SPEED_LIMIT) {
+            let peak = ctx.fine.channels[c]
+                .iter()
+                .fold(0.0f64, |a, v| a.max(v.abs()));
+            let limits: Vec<f64> = SPEED_LIMIT_GAPS.iter().map(|g| (1.0 - g) * peak).collect();
+            if peak > 0.0 {
+                columns.extend(
+                    OnGrid::at(&limits)
+                        .into_iter()
+                        .map(|l| Column::new(SPEED_LIMIT, Shape::SpeedLimit(l))),
+                );
+            }
+        }
         // A zero that settles (a sensor warming up, its offset fading).
         if fresh(FADE) {
             columns.extend(
-                FadeShape::at(fades)
+                OnGrid::at(fades)
                     .into_iter()
                     .map(|f| Column::new(FADE, Shape::Fade(f))),
             );
@@ -157,6 +202,7 @@ pub(super) fn fingerprints(
                 current_limit: column.current_limit().unwrap_or(law.shapes.current_limit),
                 harmonic: column.harmonic().unwrap_or(law.shapes.harmonic),
                 fade: column.fade().unwrap_or(law.shapes.fade),
+                speed_limit: column.speed_limit().unwrap_or(law.shapes.speed_limit),
                 ..law.shapes
             })
             .collect();
@@ -169,7 +215,7 @@ pub(super) fn fingerprints(
                 speed: speed.map_or(0.0, |k| ctx.fine.at(k, t)),
                 voltage: model.input.value_at(t).unwrap_or(model.nominal.voltage),
                 charge: 0.0,
-                heat: 0.0,
+                heat: heat[i],
                 theta: theta[i],
             };
             for (j, column) in columns.iter().enumerate() {
@@ -178,15 +224,19 @@ pub(super) fn fingerprints(
             }
         }
         let b_tilde = ctx.projector.residualize(&b);
-        // One fade, the best τ of the grid for this channel.
-        let fade = best_fade(&columns, &b_tilde, &ctx.y, |_: &Column| true);
+        // One fade, the best τ of the grid for this channel, and one speed limit.
+        let fade = best_on_grid(&columns, &b_tilde, &ctx.y, Column::fade, |_| true);
+        let limit = best_on_grid(&columns, &b_tilde, &ctx.y, Column::speed_limit, |_| true);
         out.extend(select(
             ctx,
             &columns,
             &b_tilde,
             &balance,
             shift,
-            |c: &Column| c.fade().is_none() || c.fade() == fade,
+            |c: &Column| {
+                (c.fade().is_none() || c.fade() == fade)
+                    && (c.speed_limit().is_none() || c.speed_limit() == limit)
+            },
         ));
     }
     // And a change at an instant on each channel read, a move of its own (its search paid by

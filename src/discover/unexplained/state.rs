@@ -52,7 +52,7 @@ use crate::motor::{ActiveTerm, MotorModel, Term};
 
 use super::super::candidate::Candidate;
 use super::super::settings::EVIDENCE_THRESHOLD;
-pub(super) use super::column::{Column, FadeShape, Harmonic, Shape, best_fade};
+pub(super) use super::column::{Column, Harmonic, OnGrid, Shape, best_on_grid};
 use super::fingerprint::LawFunction;
 use super::regression::{coefficient_sds, explain, gain};
 use super::{Context, Evidence, Fingerprint};
@@ -69,7 +69,7 @@ const CURRENT_LIMIT_SHARES: [f64; 6] = [0.5, 0.6, 0.7, 0.8, 0.9, 0.95];
 /// halved again while at least two sample intervals (a faster fade is over before the second
 /// sample). Halving keeps exp(−t/τ)'s column near its neighbours' (its correlation with the
 /// column at 2τ is 0.94 over a long record), as the Stribeck grid's doubling does. The best τ
-/// of a balance is offered as one move paying ln G (`column::best_fade`), as a spot or a step
+/// of a balance is offered as one move paying ln G (`column::best_on_grid`), as a spot or a step
 /// pays its grid: offered as seven columns, each paying only the step's look-elsewhere, the fade
 /// had seven tries at the noise where a function of the state has one, and on a spin-up, whose
 /// current falls about as exp(−t/τ_m), it took four laws of the state by 2 nats or less
@@ -156,7 +156,8 @@ fn law_columns(
         Shape::Harmonic(h) => shapes.harmonic = h.k,
         Shape::CurrentLimit(i) => shapes.current_limit = i,
         Shape::Spot(s) => (shapes.spot_angle, shapes.spot_width) = (s.spot.theta_0, s.spot.w),
-        Shape::Fade(f) => shapes.fade = f.tau,
+        Shape::Fade(f) => shapes.fade = f.value,
+        Shape::SpeedLimit(l) => shapes.speed_limit = l.value,
         Shape::Step(s) => shapes.instant = s.t_s,
     }
     let mut shaped = law.clone().with_active(active);
@@ -322,7 +323,7 @@ pub(super) fn fingerprints(
     for &i in &current_limits {
         add(vec![CURRENT_LIMIT], Shape::CurrentLimit(i))?;
     }
-    for fade in FadeShape::at(&fades) {
+    for fade in OnGrid::at(&fades) {
         add(vec![FADE], Shape::Fade(fade))?;
     }
     let mut out = Vec::new();
@@ -352,7 +353,7 @@ pub(super) fn fingerprints(
                 && ripple_of(f).is_none_or(|r| own_ripple.is_none_or(|o| o == r))
         };
         // One fade, the best τ of the grid for this balance.
-        let fade = best_fade(&columns, &b_tilde, &ctx.y, offered_here);
+        let fade = best_on_grid(&columns, &b_tilde, &ctx.y, Column::fade, offered_here);
         let offered = |c: &Column| offered_here(c) && (c.fade().is_none() || c.fade() == fade);
         let first = select(ctx, &columns, &b_tilde, name, shift, offered);
         // A ripple in the angle on its own as well, where the selection took another
@@ -496,7 +497,8 @@ pub(super) fn select(
     let drift = |f: &LawFunction| match f.name.as_str() {
         "t" | "exp(-t/tau)" | "step(t-t_s)" => Some("time"),
         "charge" | "U*charge" => Some("charge"),
-        "heat" => Some("heat"),
+        // A gain drifting with the heat (what is read of I, `reading`) as the heat itself.
+        "heat" | "I*heat" | "omega*heat" => Some("heat"),
         _ => None,
     };
     let fade = chosen.iter().find_map(|&j| columns[j].fade());
@@ -520,6 +522,7 @@ pub(super) fn select(
             omega_s: chosen.iter().find_map(|&j| columns[j].omega_s()),
             harmonic: chosen.iter().find_map(|&j| columns[j].harmonic()),
             current_limit: chosen.iter().find_map(|&j| columns[j].current_limit()),
+            speed_limit: chosen.iter().find_map(|&j| columns[j].speed_limit()),
             spot: chosen.iter().find_map(|&j| columns[j].spot()),
             fade,
             instant: chosen.iter().find_map(|&j| columns[j].instant()),

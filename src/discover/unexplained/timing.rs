@@ -59,8 +59,7 @@ impl FinePrediction {
     /// The integral of channel c from t = 0 (the trapezoid rule on the fine grid) at each of
     /// `times`: the angle θ = ∫ω dt of the predicted speed.
     pub(super) fn integral_at(&self, c: usize, times: &[f64]) -> Vec<f64> {
-        let sum = self.integral(c);
-        times.iter().map(|&t| self.read(&sum, t)).collect()
+        self.integral_of_at(c, |y| y, times)
     }
 
     /// The fine grid's step [s].
@@ -75,7 +74,24 @@ impl FinePrediction {
 
     /// Channel c's integral from t = 0 on the fine grid (trapezoids).
     pub(super) fn integral(&self, c: usize) -> Vec<f64> {
-        let y = &self.channels[c];
+        self.integral_of(c, |y| y)
+    }
+
+    /// The integral from t = 0 of `f` of channel c, at each of `times`: the heat ∫R·I² dt of
+    /// the predicted current with `f` = R·I².
+    pub(super) fn integral_of_at(
+        &self,
+        c: usize,
+        f: impl Fn(f64) -> f64,
+        times: &[f64],
+    ) -> Vec<f64> {
+        let sum = self.integral_of(c, f);
+        times.iter().map(|&t| self.read(&sum, t)).collect()
+    }
+
+    /// The integral from t = 0 of `f` of channel c on the fine grid (trapezoids).
+    fn integral_of(&self, c: usize, f: impl Fn(f64) -> f64) -> Vec<f64> {
+        let y: Vec<f64> = self.channels[c].iter().map(|&v| f(v)).collect();
         let h = self.step();
         let mut sum = vec![0.0; y.len()];
         for k in 1..y.len() {

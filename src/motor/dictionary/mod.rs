@@ -12,7 +12,7 @@ use super::terms::{exp_below_one, tanh};
 use super::{Magnitudes, Scalar};
 
 /// The functions, in the order of the law's parameters (within each balance).
-pub const FUNCTIONS: [&str; 32] = [
+pub const FUNCTIONS: [&str; 33] = [
     "omega",
     "omega*|omega|",
     "omega^3",
@@ -45,6 +45,7 @@ pub const FUNCTIONS: [&str; 32] = [
     "omega*exp(-2*(1-cos(theta-theta_0))/w^2)",
     "exp(-t/tau)",
     "step(t-t_s)",
+    "sign(omega)*max(|omega|-omega_lim,0)",
 ];
 
 /// How many functions the dictionary holds.
@@ -157,6 +158,16 @@ pub const FADE: usize = 30;
 /// gives t_s a derivative, and in either balance each instant tried would be a solve.
 pub const STEP: usize = 31;
 
+/// The speed beyond a limit ω_lim (a shape, searched over shares of the record's largest
+/// predicted speed, `unexplained::reading`), the current's hinge's twin: a speed sensor or an
+/// estimator at the end of its range reads ω less it. Offered in what is read of ω only: in
+/// the torque balance a load that sets in above a speed is a pump's or a fan's, which the
+/// library's quadratic drag and the powers of ω hold smoothly. Before it was offered, a speed
+/// reading clipped at its top was named a step in time of what is read of ω (on a constant
+/// input the speed crosses its top once, where a step and a clip are one column) or `unknown`
+/// (speed_clip-920002 to -920014, session 31's fifteenth set).
+pub const SPEED_LIMIT: usize = 32;
+
 /// Which of [`RIPPLES`] function `f` belongs to, if either (none: `f` is not a ripple of the
 /// balances).
 pub fn ripple_of(f: usize) -> Option<usize> {
@@ -223,6 +234,7 @@ pub fn offered_in(f: usize, b: usize) -> bool {
         I_SIN_THETA | I_COS_THETA => b == 0,
         OMEGA_SIN_THETA | OMEGA_COS_THETA | OMEGA_SPOT => b == 3,
         CONSTANT | STEP => b >= ODE_BALANCES,
+        SPEED_LIMIT => b == 3,
         _ => true,
     }
 }
@@ -257,6 +269,9 @@ pub struct Shapes {
     pub fade: f64,
     /// The instant t_s [s] of the step ([`STEP`]).
     pub instant: f64,
+    /// The speed limit ω_lim [rad/s] of `sign(omega)*max(|omega|-omega_lim,0)`
+    /// ([`SPEED_LIMIT`]).
+    pub speed_limit: f64,
 }
 
 /// Where a spot of the angle is and how wide ([`OMEGA_SPOT`]), as a report states it.
@@ -373,16 +388,12 @@ impl<'a, D: Scalar> At<'a, D> {
             // state's error and not theirs they missed finite differences by 0.33%, 0.26%,
             // 0.13% (tests/law.rs asks 0.1%). The price: a stiff limit's gain is fitted low
             // (the softened hinge acts below the limit too); its level is not.
-            CURRENT_LIMIT => {
-                let width = 0.03 * s.current_limit;
-                let z = (x.current.abs() - s.current_limit) / width;
-                let softplus = if z.re() > 0.0 {
-                    z + ((-z).exp() + 1.0).ln()
-                } else {
-                    (z.exp() + 1.0).ln()
-                };
-                softplus * width * x.current.re().signum()
-            }
+            CURRENT_LIMIT => hinge(x.current, s.current_limit, 0.03),
+            // The speed's, smoothed over a tenth of the current's share: what is read is not
+            // integrated, so no step size meets the bend and the smoothing need only keep the
+            // derivative continuous; at 0.3% the bend is narrower than the least cut tried
+            // (0.8% below the predicted peak, `unexplained::reading`).
+            SPEED_LIMIT => hinge(x.speed, s.speed_limit, 0.003),
             THETA => x.theta,
             CONSTANT => D::from(1.0),
             I_SIN_THETA => x.current * self.angle().0,
@@ -403,6 +414,19 @@ impl<'a, D: Scalar> At<'a, D> {
     }
 }
 
+/// x beyond ±`limit`, sign(x)·max(|x| − limit, 0), smoothed by a softplus over `share` of the
+/// limit.
+fn hinge<D: Scalar>(x: D, limit: f64, share: f64) -> D {
+    let width = share * limit;
+    let z = (x.abs() - limit) / width;
+    let softplus = if z.re() > 0.0 {
+        z + ((-z).exp() + 1.0).ln()
+    } else {
+        (z.exp() + 1.0).ln()
+    };
+    softplus * width * x.re().signum()
+}
+
 /// The size function `f` typically takes on this machine and record: a coefficient's prior is
 /// a tenth of its balance's scale divided by it.
 pub fn typical_size(f: usize, m: &Magnitudes) -> f64 {
@@ -415,6 +439,8 @@ pub fn typical_size(f: usize, m: &Magnitudes) -> f64 {
         // or so of its limit, so the excess is a hundredth of the current scale, and the
         // coefficient (the loop's gain, in Ω) may be many times R.
         CURRENT_LIMIT => 0.01 * m.current,
+        // A reading clipped a percent below its record's top speed: the excess it loses.
+        SPEED_LIMIT => 0.01 * m.speed,
         7 => m.current * m.current,
         9 | U_SIN_FT | U_COS_FT => m.voltage,
         CHARGE => m.current * m.duration,

@@ -14,6 +14,7 @@ fn shapes() -> Shapes {
         spot_width: 0.5,
         fade: 0.05,
         instant: 0.25,
+        speed_limit: 2000.0,
     }
 }
 
@@ -183,6 +184,49 @@ fn the_current_beyond_a_limit_is_zero_below_it_and_the_signed_excess_above() {
     assert!(near(at(400.0), (200.0, 1.0)), "{:?}", at(400.0));
     assert!(near(at(-450.0), (-250.0, 1.0)), "{:?}", at(-450.0));
     assert_eq!(FUNCTIONS[CURRENT_LIMIT], "sign(I)*max(|I|-I_lim,0)");
+}
+
+/// The speed beyond a limit, the current's hinge's twin in what is read of ω: zero below
+/// ω_lim either way round, the signed excess above it (a clip at ω_lim is −1 times it), and its
+/// derivative in the speed 0 below and 1 above — to the softplus's rounding, e^(−16) or less
+/// 16 widths (0.3% of the limit each) away from the bend.
+#[test]
+fn the_speed_beyond_a_limit_is_zero_below_it_and_the_signed_excess_above() {
+    use num_dual::Dual64;
+    let shapes = Shapes {
+        speed_limit: 2000.0,
+        ..shapes()
+    };
+    let at = |speed: f64| {
+        let x = Point {
+            t: 0.0,
+            current: Dual64::from(50.0),
+            speed: Dual64::new(speed, 1.0),
+            voltage: Dual64::from(24.0),
+            charge: Dual64::from(0.0),
+            heat: Dual64::from(0.0),
+            theta: Dual64::from(0.0),
+        };
+        let v = value(SPEED_LIMIT, &x, &shapes);
+        (v.re, v.eps)
+    };
+    let near = |(v, d): (f64, f64), (value, slope): (f64, f64)| {
+        (v - value).abs() < 1e-5 && (d - slope).abs() < 1e-5
+    };
+    assert!(near(at(1900.0), (0.0, 0.0)), "{:?}", at(1900.0));
+    assert!(near(at(-1880.0), (0.0, 0.0)), "{:?}", at(-1880.0));
+    assert!(near(at(2100.0), (100.0, 1.0)), "{:?}", at(2100.0));
+    assert!(near(at(-2300.0), (-300.0, 1.0)), "{:?}", at(-2300.0));
+    assert_eq!(
+        FUNCTIONS[SPEED_LIMIT],
+        "sign(omega)*max(|omega|-omega_lim,0)"
+    );
+    assert_eq!(pretty(FUNCTIONS[SPEED_LIMIT]), "sign(ω)·max(|ω|-ω_lim,0)");
+    // What is read of ω only.
+    let offered: Vec<bool> = (0..BALANCES.len())
+        .map(|b| offered_in(SPEED_LIMIT, b))
+        .collect();
+    assert_eq!(offered, vec![false, false, false, true]);
 }
 
 /// A spot of the angle: the speed itself at θ₀, the same a turn later, about the Gaussian

@@ -16,7 +16,8 @@ use super::{
 };
 use crate::motor::Scalar;
 use crate::motor::dictionary::{
-    self, CURRENT_LIMIT, FADE, N_FUNCTIONS, ODE_BALANCES, OMEGA_SPOT, Point, STEP, STRIBECK, Shapes,
+    self, CURRENT_LIMIT, FADE, N_FUNCTIONS, ODE_BALANCES, OMEGA_SPOT, Point, SPEED_LIMIT, STEP,
+    STRIBECK, Shapes,
 };
 use crate::parameter::Prior;
 
@@ -54,7 +55,7 @@ impl Law {
         self.active.iter().any(|k| fs.contains(&(k % N_FUNCTIONS)))
     }
 
-    /// The law with `more`'s functions as well; a shape (ω_s, k, f, I_lim, a spot, τ, t_s)
+    /// The law with `more`'s functions as well; a shape (ω_s, k, f, I_lim, a spot, τ, t_s, ω_lim)
     /// that it has no function of is taken from `more` (a law has one of each).
     pub fn extended(&self, more: &Law) -> Law {
         let mut law = self
@@ -82,6 +83,9 @@ impl Law {
         }
         if takes(&[STEP]) {
             s.instant = m.instant;
+        }
+        if takes(&[SPEED_LIMIT]) {
+            s.speed_limit = m.speed_limit;
         }
         law
     }
@@ -199,6 +203,7 @@ impl PhysicsTerm for Law {
         29 "omega*exp(-2*(1-cos(theta-theta_0))/w^2)" "N·m·s/rad" "V·s/rad" "A·s/rad" "1",
         30 "exp(-t/tau)" "N·m" "V" "A" "rad/s",
         31 "step(t-t_s)" "N·m" "V" "A" "rad/s",
+        32 "sign(omega)*max(|omega|-omega_lim,0)" "N·m·s/rad" "V·s/rad" "A·s/rad" "1",
     );
     const SETTINGS: &'static [TermSetting] = &[
         TermSetting {
@@ -264,6 +269,13 @@ impl PhysicsTerm for Law {
             speed_share: None,
             choices: &[],
         },
+        TermSetting {
+            key: "omega_lim",
+            unit: "rad/s",
+            default: 2000.0,
+            speed_share: None,
+            choices: &[],
+        },
     ];
     const STATES: &'static [TermState] = &[
         TermState {
@@ -293,6 +305,7 @@ impl PhysicsTerm for Law {
                 spot_width: positive_setting(Self::NAME, "w", s[6])?,
                 fade: positive_setting(Self::NAME, "tau", s[7])?,
                 instant: finite_setting(Self::NAME, "t_s", s[8])?,
+                speed_limit: positive_setting(Self::NAME, "omega_lim", s[9])?,
             },
         })
     }
@@ -308,6 +321,7 @@ impl PhysicsTerm for Law {
             self.shapes.spot_width,
             self.shapes.fade,
             self.shapes.instant,
+            self.shapes.speed_limit,
         ]
     }
 
