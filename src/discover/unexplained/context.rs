@@ -12,7 +12,7 @@ use super::super::coincide::input_steps;
 use super::regression::{Explained, Projector, explain};
 use super::resonance;
 use super::timing::FinePrediction;
-use super::torque_response::TorqueResponse;
+use super::torque_response::{Added, TorqueResponse};
 
 /// Input steps (besides the record's start) a ringing oscillation is fitted after at most: the
 /// largest ones; a long real record's many small steps ring too little to matter.
@@ -52,6 +52,8 @@ pub struct Context {
     /// What a torque added to the balances does to I and ω on the fine grid (the order search's
     /// columns); none on a drive base.
     pub torque: Option<TorqueResponse>,
+    /// And what a voltage added to the voltage balance does (`knocks` of the supply).
+    pub supply: Option<TorqueResponse>,
     pub ln_n: f64,
 }
 
@@ -107,6 +109,7 @@ impl Context {
         }
         let fine = FinePrediction::of(&forward, &theta, &names)?;
         let torque = TorqueResponse::of(&forward, &theta, fine.step());
+        let supply = TorqueResponse::of_added(&forward, &theta, fine.step(), Added::Voltage);
         let lagged = resonance::unlagged(&forward, &theta, &names)?;
         let projector = Projector::new(j);
         let y_perp = DVector::from_column_slice(
@@ -138,6 +141,7 @@ impl Context {
             fine,
             lagged,
             torque,
+            supply,
             ln_n: (problem.n_observations() as f64).ln(),
         })
     }

@@ -1,6 +1,7 @@
 //! The generic alternatives' results, and what the report says where one of them leads.
 
 use super::spans::Span;
+use super::torque_response::Added;
 use super::{Context, Scored, knocks, outliers, slope_noise};
 
 /// A generic alternative's result on a channel.
@@ -36,8 +37,9 @@ pub(super) enum GenericKind {
         seconds: f64,
         channels: Vec<usize>,
     },
-    /// A torque at a few isolated instants (`knocks`): the samples each starts at.
-    Knocks(Vec<usize>),
+    /// A torque (or a voltage) at a few isolated instants (`knocks`): the samples each starts
+    /// at, and the balance.
+    Knocks(Vec<usize>, Added),
 }
 
 impl GenericKind {
@@ -73,8 +75,8 @@ impl Generic {
                 let (spans, sentence) = slope_noise::reported(ctx, *seconds, channels);
                 Some((Some(spans), sentence))
             }
-            GenericKind::Knocks(starts) => {
-                let (spans, sentence) = knocks::reported(ctx, self.channel, starts);
+            GenericKind::Knocks(starts, added) => {
+                let (spans, sentence) = knocks::reported(ctx, self.channel, starts, *added);
                 Some((Some(spans), sentence))
             }
             GenericKind::Lead => Some((

@@ -22,12 +22,22 @@
 //! Candidate instants leave out the first mechanical time constant after each input step and
 //! the record's start (`candidates`): there the model's fast dynamics decide the residual, and
 //! a law of the state acting on the spin-up is a torque of a few samples.
+//!
+//! **Knocks of the supply**: the same search with the image of a voltage held over one sample
+//! interval in the voltage balance — brushes bouncing on the commutator, a loose connection or
+//! a chattering contactor lose the supply for a moment, the current dips at once and the speed
+//! follows. Before it was asked, such losses were named a law in the angle of what is read of
+//! ω, or nothing, a library term standing in with the verdict null (brush_bounce-920004 to
+//! -920016, session 31's fifteenth set). It is a second alternative beside the torque's, each
+//! scored alone at the price above, as every alternative of the verdict is: two searches at
+//! the noise, about 0.14% per record.
 
 use nalgebra::{DMatrix, DVector};
 
 use super::order::read_of;
 use super::spans::{Span, at_samples, listed};
 use super::timing::read_on_grid;
+use super::torque_response::{Added, TorqueResponse};
 use super::{Context, Scored};
 
 /// The most knocks one record is searched for: beyond a few dozen, what is left is a noise in
@@ -37,10 +47,12 @@ const MAX_KNOCKS: usize = 24;
 /// instant, where the model's mechanical time constant is shorter (as the outliers leave out).
 const AFTER_STEP: usize = 3;
 
-/// The knocks found: their score, the channel they are reported on (the speed's, which keeps
-/// the jolt), and the samples they start at, in time order.
+/// The knocks found: their score, the balance they act in, the channel they are reported on
+/// (the speed's, which keeps a torque's jolt; the current's, which takes a supply's loss at
+/// once), and the samples they start at, in time order.
 pub(super) struct Knocks {
     pub scored: Scored,
+    pub added: Added,
     pub channel: usize,
     pub starts: Vec<usize>,
 }
@@ -51,12 +63,12 @@ fn instant_price(candidates: usize, q: usize) -> f64 {
     ((candidates - q + 1) as f64 / q as f64).ln()
 }
 
-/// The whitened image, sample by sample from the knock's own, of a unit torque held over one
-/// sample interval, in each channel (stacked): none on a drive base, where the record has no
-/// current or speed channel, or where its samples are not evenly spaced (the image is then not
-/// one shape shifted).
-fn unit_image(ctx: &Context) -> Option<Vec<Vec<f64>>> {
-    let response = ctx.torque.as_ref()?;
+/// The whitened image, sample by sample from the knock's own, of a unit torque (or voltage:
+/// `response`) held over one sample interval, in each channel (stacked): none on a drive base,
+/// where the record has no current or speed channel, or where its samples are not evenly
+/// spaced (the image is then not one shape shifted).
+fn unit_image(ctx: &Context, response: Option<&TorqueResponse>) -> Option<Vec<Vec<f64>>> {
+    let response = response?;
     let n = ctx.n;
     let h = ctx.interval();
     let even = ctx
@@ -193,20 +205,40 @@ fn choose(mut b: DMatrix<f64>, mut r: DVector<f64>, ln_n: f64) -> Vec<usize> {
     chosen
 }
 
-/// The best set of knocks on the record, greedily; none where no knock pays its price.
-pub(super) fn evidence(ctx: &Context) -> Option<Knocks> {
-    let n = ctx.n;
-    if n < 20 {
-        return None;
+/// The best set of knocks on the record in each balance, greedily: none in a balance where no
+/// knock pays its price. The candidate instants are the torque's (`candidates`) for both: what
+/// they leave out is where the model's own dynamics decide the residual.
+pub(super) fn evidence(ctx: &Context) -> Vec<Knocks> {
+    if ctx.n < 20 {
+        return Vec::new();
     }
-    let image = unit_image(ctx)?;
-    let at = candidates(ctx, settle(ctx, &image));
+    let Some(torque) = unit_image(ctx, ctx.torque.as_ref()) else {
+        return Vec::new();
+    };
+    let at = candidates(ctx, settle(ctx, &torque));
+    let current = ctx.channels.iter().position(|c| c == "I");
+    let supply = unit_image(ctx, ctx.supply.as_ref()).zip(current);
+    std::iter::once((Added::Torque, torque, speed_channel(ctx).unwrap_or(0)))
+        .chain(supply.map(|(image, c)| (Added::Voltage, image, c)))
+        .filter_map(|(added, image, channel)| in_balance(ctx, &image, &at, added, channel))
+        .collect()
+}
+
+/// The knocks of one balance whose unit image is `image`, among the instants `at`.
+fn in_balance(
+    ctx: &Context,
+    image: &[Vec<f64>],
+    at: &[usize],
+    added: Added,
+    channel: usize,
+) -> Option<Knocks> {
+    let n = ctx.n;
     let k_all = at.len();
     if k_all == 0 {
         return None;
     }
     // Every candidate's column, residualized on the model's sensitivities.
-    let b = images(ctx.m(), n, &image, &at);
+    let b = images(ctx.m(), n, image, at);
     let chosen = choose(ctx.projector.residualize(&b), ctx.y_perp.clone(), ctx.ln_n);
     if chosen.is_empty() {
         return None;
@@ -215,31 +247,48 @@ pub(super) fn evidence(ctx: &Context) -> Option<Knocks> {
     // alternative is, the instants' price on top.
     let q = chosen.len();
     let starts: Vec<usize> = chosen.iter().map(|&j| at[j]).collect();
-    let columns = images(ctx.m(), n, &image, &starts);
+    let columns = images(ctx.m(), n, image, &starts);
     let location: f64 = (1..=q).map(|p| instant_price(k_all, p)).sum();
     let scored = ctx.score(&columns, location);
     let mut starts = starts;
     starts.sort_unstable();
     Some(Knocks {
         scored,
-        channel: speed_channel(ctx).unwrap_or(0),
+        added,
+        channel,
         starts,
     })
 }
 
-/// The verdict's `where` and its sentence where knocks lead: the instants each starts at, on
-/// channel `c`.
-pub(super) fn reported(ctx: &Context, c: usize, starts: &[usize]) -> (Vec<Span>, String) {
+/// The verdict's `where` and its sentence where knocks of `added`'s balance lead: the instants
+/// each starts at, on channel `c`.
+pub(super) fn reported(
+    ctx: &Context,
+    c: usize,
+    starts: &[usize],
+    added: Added,
+) -> (Vec<Span>, String) {
     let instants: Vec<f64> = starts.iter().map(|&i| ctx.times[i]).collect();
-    let sentence = format!(
-        "the motor is jolted by a torque at {} isolated instant{} (t = {} s) that follows \
-         nothing of the state: a loose part striking, a coupling or clutch catching, or a load \
-         that jerks, rather than a law; look for what happens at those instants, and record \
-         again with the load uncoupled to tell the motor from what it drives",
+    let (count, plural, at) = (
         instants.len(),
         if instants.len() == 1 { "" } else { "s" },
         listed(&instants),
     );
+    let sentence = match added {
+        Added::Torque => format!(
+            "the motor is jolted by a torque at {count} isolated instant{plural} (t = {at} s) \
+             that follows nothing of the state: a loose part striking, a coupling or clutch \
+             catching, or a load that jerks, rather than a law; look for what happens at those \
+             instants, and record again with the load uncoupled to tell the motor from what it \
+             drives"
+        ),
+        Added::Voltage => format!(
+            "the winding loses part of its supply for a moment at {count} isolated \
+             instant{plural} (t = {at} s), following nothing of the state: brushes bouncing on \
+             the commutator, a loose connection or a contactor chattering, rather than a law; \
+             a record of the voltage at the motor's terminals would show the drops"
+        ),
+    };
     (at_samples(ctx, c, starts), sentence)
 }
 

@@ -72,7 +72,8 @@ pub use as_given::{AsGiven, beyond_the_library};
 pub use context::{Context, Scored};
 pub use figure::{FOLDED_BINS, Folded, UnexplainedFigure};
 pub use fingerprint::{
-    EquationTerm, Fingerprint, LawFunction, equation_with, with_shapes, with_spot, with_time,
+    EquationTerm, Fingerprint, LawFunction, equation_with, with_shapes, with_speed_limit,
+    with_spot, with_time,
 };
 use generic::{Generic, GenericKind};
 pub use oscillation::{frequency_search_cost, lowest_frequency_over};
@@ -233,10 +234,10 @@ fn scores(ctx: &Context, shift: f64) -> Scores {
         // The lag's next model: a sensor that rings.
         fingerprints.extend(resonance::evidence(ctx, c, lag, shift));
     }
-    if let Some(k) = knocks::evidence(ctx) {
+    for k in knocks::evidence(ctx) {
         generic.push(Generic {
             channel: k.channel,
-            kind: GenericKind::Knocks(k.starts),
+            kind: GenericKind::Knocks(k.starts, k.added),
             scored: k.scored,
         });
     }

@@ -13,6 +13,9 @@
 //! `fit --map-only` of each law). The columns below are what the regression should see: the
 //! torque's image through the balances.
 //!
+//! The same map steps a small voltage added to the voltage balance (a supply that drops for a
+//! moment, `knocks`), its input vector (1/L, 0) in place of the torque's (0, 1/J).
+//!
 //! Only the base's balances: a term's own dynamics (a coupling, a lag) and its dependence on
 //! the state are left out. The search needs where the peak is; the fingerprint then solves the
 //! law's columns through the whole ODE at the order found and scores those.
@@ -23,11 +26,19 @@ use crate::forward::ForwardModel;
 use crate::motor::{Base, MotorParam};
 
 /// The linear balances' exact one-step map on a grid of step h:
-/// x ← A_h·x + b_h·τ, with x = (I, ω) and τ held over the step.
+/// x ← A_h·x + b_h·τ, with x = (I, ω) and τ (a torque, or a voltage: [`Added`]) held over the
+/// step.
 #[derive(Clone, Debug)]
 pub struct TorqueResponse {
     a_h: Matrix2<f64>,
     b_h: Vector2<f64>,
+}
+
+/// Which balance the small input is added to.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Added {
+    Torque,
+    Voltage,
 }
 
 impl TorqueResponse {
@@ -36,6 +47,12 @@ impl TorqueResponse {
     /// `h`. None for a drive base, whose balances are the drive's, or where L or J is not
     /// positive.
     pub fn of(forward: &ForwardModel, theta: &[f64], h: f64) -> Option<Self> {
+        Self::of_added(forward, theta, h, Added::Torque)
+    }
+
+    /// The same balances with the small input added to `added`'s balance: τ/J to dω/dt, or
+    /// v/L to dI/dt.
+    pub fn of_added(forward: &ForwardModel, theta: &[f64], h: f64, added: Added) -> Option<Self> {
         let model = forward.model();
         if model.base != Base::VoltageDriven || model.drive.is_some() {
             return None;
@@ -60,9 +77,13 @@ impl TorqueResponse {
         if !(l > 0.0 && j > 0.0 && h > 0.0) {
             return None;
         }
+        let b = match added {
+            Added::Torque => Vector2::new(0.0, 1.0 / j),
+            Added::Voltage => Vector2::new(1.0 / l, 0.0),
+        };
         Some(Self::of_balances(
             Matrix2::new(-r / l, -c_m / l, c_g / j, -d / j),
-            Vector2::new(0.0, 1.0 / j),
+            b,
             h,
         ))
     }
@@ -125,5 +146,30 @@ mod tests {
         // Early on the inertia alone holds the torque: ω ≈ τ·t/J over the first few steps,
         // while the current has barely moved.
         assert!((speed[3] - 1e-3 * 3e-4 / j).abs() < 0.01 * speed[3]);
+    }
+
+    #[test]
+    fn a_held_voltage_brings_the_balances_to_the_motors_own_steady_state() {
+        // A voltage v added to the voltage balance is the supply's own: at rest R·I + c_m·ω = v
+        // and c_g·I = d·ω, the paper's no-load speed per volt; over the first step the winding
+        // alone answers, I = v/R·(1 − e^(−R·h/L)), while the speed has barely moved.
+        let (r, l, c, d, j) = (0.1, 1e-4, 0.01, 1e-6, 5e-5);
+        let response = TorqueResponse::of_balances(
+            Matrix2::new(-r / l, -c / l, c / j, -d / j),
+            Vector2::new(1.0 / l, 0.0),
+            1e-4,
+        );
+        let [current, speed] = response.respond(&vec![1.0; 5001]);
+        let omega = c / (r * d + c * c);
+        assert!(
+            (speed[5000] - omega).abs() < 1e-4 * omega,
+            "{}",
+            speed[5000]
+        );
+        // The current's e^(−10) left is of its start-up's v/R, not of the small d·ω/c_g.
+        assert!((current[5000] - d * omega / c).abs() < 1e-4 / r);
+        let first = (1.0 - (-r * 1e-4 / l).exp()) / r;
+        assert!((current[1] - first).abs() < 1e-3 * first, "{}", current[1]);
+        assert!(speed[1] < 1e-3 * omega);
     }
 }
