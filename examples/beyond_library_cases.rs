@@ -31,7 +31,10 @@
 //! `dead_time`, `winding_heat`, `ac_coupled_tacho`, `loose_part`; a fourteenth (session 31),
 //! `gravity_arm`, `brake_release`, `current_offset_step`, `speed_range_switch`; a fifteenth
 //! (session 31, made after the fade and the step were written, to judge them blind),
-//! `load_mass_change`, `speed_clip`, `sensor_gain_heat`, `brush_bounce`.
+//! `load_mass_change`, `speed_clip`, `sensor_gain_heat`, `brush_bounce`; a sixteenth (session
+//! 32, made after the heat and the speed's range in what is read and the supply's knocks were
+//! written, to judge them blind), `bearing_heat_drag`, `current_deadband`,
+//! `tacho_heat_offset`, `current_skew`.
 //!
 //! cargo run --release --example beyond_library_cases -- [--out DIR] [--per-effect 3]
 //!     [--seed-base 510000] [--min-nats 20] [--max-nats 300] [--effects a,b,…] [--volts 24]
@@ -300,6 +303,18 @@ enum Effect {
     /// Brushes bouncing on the commutator: in each 25-ms window, with probability one half, the
     /// winding sees (1 − d)·U for 1 ms at a random instant. `--effects brush_bounce`.
     BrushBounce { d: f64, salt: u64 },
+    /// A bearing whose drag grows as the motor warms (a seal's preload rising as the housing
+    /// expands): a torque a·E·tanh(ω), E = ∫R·I²dt. `--effects bearing_heat_drag`.
+    BearingHeatDrag { a: f64 },
+    /// A Hall current sensor with a dead band: it reads sign(I)·max(|I| − I_d, 0).
+    /// `--effects current_deadband`.
+    CurrentDeadband { i_d: f64 },
+    /// A tachometer whose zero drifts as the motor warms it: ω read as ω + b·E.
+    /// `--effects tacho_heat_offset`.
+    TachoHeatOffset { b: f64 },
+    /// A multiplexed converter that samples the current τ before the speed and stamps both
+    /// at the speed's instant: what is read of I is I(t − τ). `--effects current_skew`.
+    CurrentSkew { tau: f64 },
 }
 
 /// splitmix64's finalizer: the draws below of a case's salt and a sample's or a window's index.
@@ -566,6 +581,10 @@ impl Effect {
                 d: 0.1,
                 salt: rng.random(),
             },
+            "bearing_heat_drag" => Effect::BearingHeatDrag { a: 1e-4 },
+            "current_deadband" => Effect::CurrentDeadband { i_d: 1.0 },
+            "tacho_heat_offset" => Effect::TachoHeatOffset { b: 0.1 },
+            "current_skew" => Effect::CurrentSkew { tau: 1e-4 },
             other => panic!("unknown effect {other}; known: {:?}", Effect::NAMES),
         }
     }
@@ -637,6 +656,10 @@ impl Effect {
             Effect::SpeedClip { cut } => cut,
             Effect::SensorGainHeat { beta } => beta,
             Effect::BrushBounce { d, .. } => d,
+            Effect::BearingHeatDrag { a } => a,
+            Effect::CurrentDeadband { i_d } => i_d,
+            Effect::TachoHeatOffset { b } => b,
+            Effect::CurrentSkew { tau } => tau,
         }
     }
 
@@ -706,6 +729,10 @@ impl Effect {
             Effect::SpeedClip { cut } => *cut = s,
             Effect::SensorGainHeat { beta } => *beta = s,
             Effect::BrushBounce { d, .. } => *d = s,
+            Effect::BearingHeatDrag { a } => *a = s,
+            Effect::CurrentDeadband { i_d } => *i_d = s,
+            Effect::TachoHeatOffset { b } => *b = s,
+            Effect::CurrentSkew { tau } => *tau = s,
         }
         e
     }
@@ -782,6 +809,12 @@ impl Effect {
             Effect::SpeedClip { .. } => 0.5,
             Effect::SensorGainHeat { .. } => 0.01,
             Effect::BrushBounce { .. } => 1.0,
+            // A drag of at most 1 N·m per 100 J; a dead band of at most 50 A; a zero off by at
+            // most 10 rad/s per joule; a skew of at most two samples.
+            Effect::BearingHeatDrag { .. } => 0.01,
+            Effect::CurrentDeadband { .. } => 50.0,
+            Effect::TachoHeatOffset { .. } => 10.0,
+            Effect::CurrentSkew { .. } => 2e-3,
             _ => 1.0,
         }
     }
@@ -1006,7 +1039,13 @@ fn rhs(
                 motor_inertia = m.j * (1.0 + eps);
             }
         }
-        Some(Effect::SensorGainHeat { .. }) => dx[2] = m.r * i * i,
+        Some(Effect::SensorGainHeat { .. } | Effect::TachoHeatOffset { .. }) => {
+            dx[2] = m.r * i * i
+        }
+        Some(&Effect::BearingHeatDrag { a }) => {
+            torque -= a * x[2] * w.tanh();
+            dx[2] = m.r * i * i;
+        }
         Some(&Effect::BrushBounce { d, salt }) => {
             let window = 0.025;
             if t >= 0.0 {
@@ -1037,7 +1076,9 @@ fn rhs(
             | Effect::AsymmetricTacho { .. }
             | Effect::CurrentOffsetStep { .. }
             | Effect::SpeedRangeSwitch { .. }
-            | Effect::SpeedClip { .. },
+            | Effect::SpeedClip { .. }
+            | Effect::CurrentDeadband { .. }
+            | Effect::CurrentSkew { .. },
         )
         // Their balances are rewritten below.
         | Some(Effect::MountResonance { .. } | Effect::ShortedTurn { .. })
@@ -1103,6 +1144,10 @@ fn measured(e: Option<&Effect>, x: &[f64; 4]) -> [f64; 2] {
         Some(&Effect::MagnetPickup { a, phase }) => [x[0] + a * (x[2] + phase).sin(), x[1]],
         Some(&Effect::AsymmetricTacho { eps }) => [x[0], x[1] + eps * x[1].abs()],
         Some(&Effect::SensorGainHeat { beta }) => [x[0] * (1.0 + beta * x[2]), x[1]],
+        Some(&Effect::TachoHeatOffset { b }) => [x[0], x[1] + b * x[2]],
+        Some(&Effect::CurrentDeadband { i_d }) => {
+            [x[0].signum() * (x[0].abs() - i_d).max(0.0), x[1]]
+        }
         Some(Effect::AcCoupledTacho { .. }) => [x[0], x[1] - x[2]],
         Some(&Effect::EncoderMissingLine { eps, phase }) => {
             let wrapped = (x[2] + phase + PI).rem_euclid(2.0 * PI) - PI;
@@ -1122,8 +1167,10 @@ fn simulate(m: &Motor, e: Option<&Effect>, input: &Input, times: &[f64]) -> Vec<
     let mut x = [0.0; 4];
     let mut t = 0.0;
     let mut out = Vec::with_capacity(times.len());
-    // The speed at every substep, for a reading that arrives late (linear between substeps).
+    // The speed and the current at every substep, for a reading that arrives late (linear
+    // between substeps).
     let mut history: Vec<(f64, f64)> = vec![(0.0, 0.0)];
+    let mut current_history: Vec<(f64, f64)> = vec![(0.0, 0.0)];
     let mut last_read = 0.0;
     for &target in times {
         let h = (target - t) / SUBSTEPS as f64;
@@ -1139,19 +1186,14 @@ fn simulate(m: &Motor, e: Option<&Effect>, input: &Input, times: &[f64]) -> Vec<
             });
             t += h;
             history.push((t, x[1]));
+            current_history.push((t, x[0]));
         }
         let mut y = measured(e, &x);
         if let Some(&Effect::EncoderLatency { tau }) = e {
-            let late = t - tau;
-            let j = history.partition_point(|p| p.0 <= late);
-            y[1] = if j == 0 {
-                0.0
-            } else if j == history.len() {
-                history[j - 1].1
-            } else {
-                let (a, b) = (history[j - 1], history[j]);
-                a.1 + (b.1 - a.1) * (late - a.0) / (b.0 - a.0)
-            };
+            y[1] = read_late(&history, t - tau);
+        }
+        if let Some(&Effect::CurrentSkew { tau }) = e {
+            y[0] = read_late(&current_history, t - tau);
         }
         if let Some(&Effect::SpeedWindow { t_w }) = e {
             y[1] = window_mean(&history, t - t_w, t);
@@ -1217,6 +1259,20 @@ fn simulate(m: &Motor, e: Option<&Effect>, input: &Input, times: &[f64]) -> Vec<
         out.push(y);
     }
     out
+}
+
+/// A channel's substep history read at `late` (linear between substeps; at rest before the
+/// start, the last value after the end).
+fn read_late(history: &[(f64, f64)], late: f64) -> f64 {
+    let j = history.partition_point(|p| p.0 <= late);
+    if j == 0 {
+        0.0
+    } else if j == history.len() {
+        history[j - 1].1
+    } else {
+        let (a, b) = (history[j - 1], history[j]);
+        a.1 + (b.1 - a.1) * (late - a.0) / (b.0 - a.0)
+    }
 }
 
 /// The mean of the speed over [from, to] from its substep history (trapezoids, linear between
@@ -1428,6 +1484,14 @@ fn expected(e: &Effect, input_level: f64) -> String {
         // Short losses of the supply at random instants follow nothing of the state:
         // something is left on I.
         Effect::BrushBounce { .. } => r#"{"kind": "unknown", "channel": "I"}"#.into(),
+        // A torque growing with the heat: a drift with the heat, of the torque balance.
+        Effect::BearingHeatDrag { .. } => r#"{"kind": "drift", "variable": "heat", "balance": "torque"}"#.into(),
+        // What is read of I, a function of I (a hinge): the kind and the place are asked.
+        Effect::CurrentDeadband { .. } => r#"{"kind": "state", "balance": "measurement:I"}"#.into(),
+        // What is read of ω, drifting with the heat.
+        Effect::TachoHeatOffset { .. } => r#"{"kind": "drift", "variable": "heat", "balance": "measurement:omega"}"#.into(),
+        // The current alone late by τ: a lag of I (a first-order filter of τ lags by τ).
+        Effect::CurrentSkew { tau } => format!(r#"{{"kind": "lag", "channel": "I", "seconds": {tau}}}"#),
         // The flux's ripple in both balances (as flux_saturation's): the kind, the angle and
         // the order are asked.
         Effect::CommutatorRipple { k, .. } => format!(r#"{{"kind": "state", "functions": ["omega*sin(k*theta)", "omega*cos(k*theta)", "I*sin(k*theta)", "I*cos(k*theta)"], "k": {k}}}"#),

@@ -6,7 +6,7 @@
 #   residual           what the library's best single term leaves (library-residual-$SEED.md)
 #   diagnose BIN NAME  whole commands, two at a time, into $T/NAME and $T/tNAME/$SET
 set -e
-T=${T:-/tmp/s31/b}; HERE=papers/beyond-library/session31
+T=${T:-/tmp/s31/b}; HERE=${HERE:-papers/beyond-library/session31}
 case $1 in
 cases)
   target/release/examples/beyond_library_cases --out $T/cases/$SET \
