@@ -58,7 +58,8 @@ const MEASURED: [usize; 11] = [0, 1, 2, 5, 7, 9, 12, CONSTANT, THETA, HEAT, I_HE
 /// The input, offered where it varies.
 const INPUT: usize = 9;
 /// Those of them that read the speed (`omega`, `omega*|omega|`, `omega^3`, `theta`), and the
-/// current (`I`, `I*|I|`): offered only on that channel's own reading.
+/// current (`I`, `I*|I|`, and the heat it draws, `heat`, `I*heat`): offered only on that
+/// channel's own reading.
 const READS_SPEED: [usize; 4] = [0, 1, 2, THETA];
 const READS_CURRENT: [usize; 4] = [5, 7, HEAT, I_HEAT];
 /// The speed itself read on the speed's channel: a gain, the library's `speed_gain`.
