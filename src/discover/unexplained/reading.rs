@@ -166,17 +166,14 @@ pub(super) fn fingerprints(
         }
         // A reading clipped at the top of its range (ω's; the current's is the hinge above).
         if Some(c) == speed && fresh(SPEED_LIMIT) {
-            let peak = ctx.fine.channels[c]
-                .iter()
-                .fold(0.0f64, |a, v| a.max(v.abs()));
-            let limits: Vec<f64> = SPEED_LIMIT_GAPS.iter().map(|g| (1.0 - g) * peak).collect();
-            if peak > 0.0 {
-                columns.extend(
-                    OnGrid::at(&limits)
-                        .into_iter()
-                        .map(|l| Column::new(SPEED_LIMIT, Shape::SpeedLimit(l))),
-                );
-            }
+            let limits = ctx
+                .fine
+                .shares_of_peak(c, &SPEED_LIMIT_GAPS.map(|g| 1.0 - g));
+            columns.extend(
+                OnGrid::at(&limits)
+                    .into_iter()
+                    .map(|l| Column::new(SPEED_LIMIT, Shape::SpeedLimit(l))),
+            );
         }
         // A zero that settles (a sensor warming up, its offset fading).
         if fresh(FADE) {

@@ -273,23 +273,12 @@ pub(super) fn fingerprints(
     };
     let current_limits: Vec<f64> = match &own {
         Some(l) if holds(CURRENT_LIMIT) => vec![l.shapes.current_limit],
-        _ => {
-            let peak = ctx
-                .channels
-                .iter()
-                .position(|c| c == "I")
-                .map(|c| {
-                    ctx.fine.channels[c]
-                        .iter()
-                        .fold(0.0f64, |a, v| a.max(v.abs()))
-                })
-                .unwrap_or(0.0);
-            if peak > 0.0 {
-                CURRENT_LIMIT_SHARES.iter().map(|s| s * peak).collect()
-            } else {
-                Vec::new()
-            }
-        }
+        _ => ctx
+            .channels
+            .iter()
+            .position(|c| c == "I")
+            .map(|c| ctx.fine.shares_of_peak(c, &CURRENT_LIMIT_SHARES))
+            .unwrap_or_default(),
     };
     let fades: Vec<f64> = match &own {
         Some(l) if holds(FADE) => vec![l.shapes.fade],

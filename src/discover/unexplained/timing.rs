@@ -62,6 +62,17 @@ impl FinePrediction {
         self.integral_of_at(c, |y| y, times)
     }
 
+    /// `shares` of channel c's largest |value| on the fine grid (a limit's grid below the
+    /// predicted peak); none where the channel stays at zero.
+    pub(super) fn shares_of_peak(&self, c: usize, shares: &[f64]) -> Vec<f64> {
+        let peak = self.channels[c].iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        if peak > 0.0 {
+            shares.iter().map(|s| s * peak).collect()
+        } else {
+            Vec::new()
+        }
+    }
+
     /// The fine grid's step [s].
     pub(super) fn step(&self) -> f64 {
         self.times[1] - self.times[0]
