@@ -334,6 +334,7 @@ fn the_dictionary_at_one_point_gives_each_shared_factor_its_own_formula_in_any_o
         fade: 0.05,
         instant: 0.25,
         speed_limit: 2000.0,
+        current_smooth: 1.0,
     };
     // A direction through every state at once, so a factor taken for another one shows.
     let x = Point {
@@ -357,6 +358,7 @@ fn the_dictionary_at_one_point_gives_each_shared_factor_its_own_formula_in_any_o
             "sign(omega)" => sign,
             // I < 0 here: |I| is −I.
             "sign(omega)*|I|" => sign * -x.current,
+            "sign(omega)*heat" => sign * x.heat,
             "exp(-(omega/omega_s)^2)*sign(omega)" => (-(r * r)).exp() * sign,
             "sin(k*theta)" => angle.sin(),
             "cos(k*theta)" => angle.cos(),
@@ -385,7 +387,7 @@ fn the_dictionary_at_one_point_gives_each_shared_factor_its_own_formula_in_any_o
                 || name.contains("cos")
         })
         .collect();
-    assert_eq!(shared.len(), 14);
+    assert_eq!(shared.len(), 15);
     for order in [shared.clone(), shared.iter().rev().copied().collect()] {
         let here = At::new(&x, &shapes);
         for &f in &order {

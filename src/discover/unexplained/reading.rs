@@ -7,7 +7,7 @@ use nalgebra::DMatrix;
 use crate::motor::Term;
 use crate::motor::dictionary::{
     self, CONSTANT, CURRENT_LIMIT, FADE, HEAT, I_HEAT, N_FUNCTIONS, OMEGA_SPOT, Point,
-    READING_RIPPLE, RIPPLES, SPEED_LIMIT, STEP, Shapes, THETA,
+    READING_RIPPLE, RIPPLES, SIGN_I, SPEED_LIMIT, STEP, Shapes, THETA,
 };
 
 use super::super::candidate::Candidate;
@@ -52,16 +52,22 @@ use super::{Context, Evidence};
 /// the winding's circuit warms with the same I², and a reading whose zero drifts with its
 /// temperature reads heat, one whose gain drifts reads I·heat. Before, a gain drifting so
 /// (sensor_gain_heat-920003 to -920015, session 31's fifteenth set) was named a law in I and a
-/// fade, or `unknown`. Offered on I only: a speed sensor sits on the shaft, not in the
-/// current's circuit. Two columns more on I raise its first's price by ln(10/8), 0.22 nats.
-const MEASURED: [usize; 11] = [0, 1, 2, 5, 7, 9, 12, CONSTANT, THETA, HEAT, I_HEAT];
+/// fade, or `unknown`. Two columns more on I raise its first's price by ln(10/8), 0.22 nats.
+///
+/// The heat is offered on ω too (not its product): a tachometer or an encoder's electronics
+/// on the motor's end shield warm with the winding, and a zero that drifts with its
+/// temperature reads the heat drawn (tacho_heat_offset-930003 to -930015, session 32's
+/// sixteenth set, were named a state of the voltage balance or a drift in time). The current's
+/// sign (`dictionary::SIGN_I`, smoothed over the law's I_s) is offered on I: a sensor's dead
+/// band. One column more on each raises its first's price by ln(9/8) and ln(11/10), 0.12 and
+/// 0.10 nats.
+const MEASURED: [usize; 12] = [0, 1, 2, 5, 7, 9, 12, CONSTANT, THETA, HEAT, I_HEAT, SIGN_I];
 /// The input, offered where it varies.
 const INPUT: usize = 9;
 /// Those of them that read the speed (`omega`, `omega*|omega|`, `omega^3`, `theta`), and the
-/// current (`I`, `I*|I|`, and the heat it draws, `heat`, `I*heat`): offered only on that
-/// channel's own reading.
+/// current (`I`, `I*|I|`, `I*heat`, `sign(I)`): offered only on that channel's own reading.
 const READS_SPEED: [usize; 4] = [0, 1, 2, THETA];
-const READS_CURRENT: [usize; 4] = [5, 7, HEAT, I_HEAT];
+const READS_CURRENT: [usize; 4] = [5, 7, I_HEAT, SIGN_I];
 /// The speed itself read on the speed's channel: a gain, the library's `speed_gain`.
 const SPEED: usize = 0;
 
@@ -151,6 +157,8 @@ pub(super) fn fingerprints(
             .filter(|f| Some(c) == current || !READS_CURRENT.contains(f))
             .filter(|&f| fresh(f))
             .filter(|&f| f != CONSTANT || Some(c) == speed)
+            // The heat is the predicted current's: none where the current is not read.
+            .filter(|&f| f != HEAT || current.is_some())
             .filter(|&f| f != INPUT || Some(c) != speed || input_varies)
             .collect();
         let mut columns: Vec<Column> = functions

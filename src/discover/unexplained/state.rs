@@ -487,7 +487,7 @@ pub(super) fn select(
         "t" | "exp(-t/tau)" | "step(t-t_s)" => Some("time"),
         "charge" | "U*charge" => Some("charge"),
         // A gain drifting with the heat (what is read of I, `reading`) as the heat itself.
-        "heat" | "I*heat" | "omega*heat" => Some("heat"),
+        "heat" | "I*heat" | "omega*heat" | "sign(omega)*heat" => Some("heat"),
         _ => None,
     };
     let fade = chosen.iter().find_map(|&j| columns[j].fade());

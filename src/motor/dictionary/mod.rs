@@ -12,7 +12,7 @@ use super::terms::{exp_below_one, tanh};
 use super::{Magnitudes, Scalar};
 
 /// The functions, in the order of the law's parameters (within each balance).
-pub const FUNCTIONS: [&str; 33] = [
+pub const FUNCTIONS: [&str; 35] = [
     "omega",
     "omega*|omega|",
     "omega^3",
@@ -46,6 +46,8 @@ pub const FUNCTIONS: [&str; 33] = [
     "exp(-t/tau)",
     "step(t-t_s)",
     "sign(omega)*max(|omega|-omega_lim,0)",
+    "sign(I)",
+    "sign(omega)*heat",
 ];
 
 /// How many functions the dictionary holds.
@@ -168,6 +170,27 @@ pub const STEP: usize = 31;
 /// (speed_clip-920002 to -920014, session 31's fifteenth set).
 pub const SPEED_LIMIT: usize = 32;
 
+/// The current's sign, smoothed over I_s as the library's voltage drop smooths it: what is read
+/// of I by a sensor with a dead band (a Hall cell's, a converter's offset compensation) reads
+/// sign(I)·max(|I| − I_d, 0), I less about I_d·sign(I) wherever |I| is well above I_d. On a
+/// record whose current never reverses that is the library's `current_offset`; where it
+/// reverses the offset changes sign with it, and before it was offered such a reading was named
+/// `unknown` (current_deadband-930002, -930006, -930014, session 32's sixteenth set, blind).
+/// Offered in what is read of I only: in the voltage balance the current's sign is the
+/// library's `voltage_drop` (a bridge's dead time, the brushes' drop), and a torque that
+/// follows the current's sign and not the speed's has no physics in a motor behind it.
+pub const SIGN_I: usize = 33;
+
+/// The speed's sign times the heat drawn: a friction that grows with the winding's temperature
+/// (a bearing's drag as the heat reaches it, a seal's), c·E·sign(ω) to first order. The heat
+/// alone is offered in the torque balance too, and on a record that turns one way the two are
+/// one column; where the speed reverses, a drag reverses with it and a load does not, and before
+/// it was offered such a drag was named a fade and a Coulomb friction, or the library's
+/// `load_step` beside it (bearing_heat_drag-930013, session 32's sixteenth set, blind). A drift
+/// with the heat, as the heat itself is. Offered in the torque balance only, where friction
+/// acts.
+pub const SIGN_OMEGA_HEAT: usize = 34;
+
 /// Which of [`RIPPLES`] function `f` belongs to, if either (none: `f` is not a ripple of the
 /// balances).
 pub fn ripple_of(f: usize) -> Option<usize> {
@@ -235,6 +258,8 @@ pub fn offered_in(f: usize, b: usize) -> bool {
         OMEGA_SIN_THETA | OMEGA_COS_THETA | OMEGA_SPOT => b == 3,
         CONSTANT | STEP => b >= ODE_BALANCES,
         SPEED_LIMIT => b == 3,
+        SIGN_I => b == 2,
+        SIGN_OMEGA_HEAT => b == 0,
         _ => true,
     }
 }
@@ -243,7 +268,7 @@ pub fn offered_in(f: usize, b: usize) -> bool {
 pub fn state_of(function: usize) -> Option<usize> {
     match function {
         CHARGE | U_CHARGE => Some(0),
-        HEAT | OMEGA_HEAT | I_HEAT => Some(1),
+        HEAT | OMEGA_HEAT | I_HEAT | SIGN_OMEGA_HEAT => Some(1),
         SIN_THETA | COS_THETA | THETA | I_SIN_THETA | I_COS_THETA | OMEGA_SIN_THETA
         | OMEGA_COS_THETA | OMEGA_SPOT => Some(2),
         _ => None,
@@ -272,6 +297,8 @@ pub struct Shapes {
     /// The speed limit ω_lim [rad/s] of `sign(omega)*max(|omega|-omega_lim,0)`
     /// ([`SPEED_LIMIT`]).
     pub speed_limit: f64,
+    /// The smoothing current I_s [A] of `sign(I)` ([`SIGN_I`]).
+    pub current_smooth: f64,
 }
 
 /// Where a spot of the angle is and how wide ([`OMEGA_SPOT`]), as a report states it.
@@ -394,6 +421,8 @@ impl<'a, D: Scalar> At<'a, D> {
             // derivative continuous; at 0.3% the bend is narrower than the least cut tried
             // (0.8% below the predicted peak, `unexplained::reading`).
             SPEED_LIMIT => hinge(x.speed, s.speed_limit, 0.003),
+            SIGN_I => tanh(x.current / s.current_smooth),
+            SIGN_OMEGA_HEAT => self.sign() * x.heat,
             THETA => x.theta,
             CONSTANT => D::from(1.0),
             I_SIN_THETA => x.current * self.angle().0,
@@ -446,7 +475,7 @@ pub fn typical_size(f: usize, m: &Magnitudes) -> f64 {
         CHARGE => m.current * m.duration,
         U_CHARGE => m.voltage * m.current * m.duration,
         // R·I² over the record: U·I at stall.
-        HEAT => m.voltage * m.current * m.duration,
+        HEAT | SIGN_OMEGA_HEAT => m.voltage * m.current * m.duration,
         OMEGA_HEAT => m.speed * m.voltage * m.current * m.duration,
         I_HEAT => m.current * m.voltage * m.current * m.duration,
         TIME => m.duration,

@@ -15,6 +15,7 @@ fn shapes() -> Shapes {
         fade: 0.05,
         instant: 0.25,
         speed_limit: 2000.0,
+        current_smooth: 1.0,
     }
 }
 

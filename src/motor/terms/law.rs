@@ -204,6 +204,8 @@ impl PhysicsTerm for Law {
         30 "exp(-t/tau)" "N·m" "V" "A" "rad/s",
         31 "step(t-t_s)" "N·m" "V" "A" "rad/s",
         32 "sign(omega)*max(|omega|-omega_lim,0)" "N·m·s/rad" "V·s/rad" "A·s/rad" "1",
+        33 "sign(I)" "N·m" "V" "A" "rad/s",
+        34 "sign(omega)*heat" "N·m/J" "V/J" "A/J" "rad/(s·J)",
     );
     const SETTINGS: &'static [TermSetting] = &[
         TermSetting {
@@ -276,6 +278,14 @@ impl PhysicsTerm for Law {
             speed_share: None,
             choices: &[],
         },
+        // As the library's voltage drop smooths the current's sign.
+        TermSetting {
+            key: "I_s",
+            unit: "A",
+            default: 1.0,
+            speed_share: None,
+            choices: &[],
+        },
     ];
     const STATES: &'static [TermState] = &[
         TermState {
@@ -306,6 +316,7 @@ impl PhysicsTerm for Law {
                 fade: positive_setting(Self::NAME, "tau", s[7])?,
                 instant: finite_setting(Self::NAME, "t_s", s[8])?,
                 speed_limit: positive_setting(Self::NAME, "omega_lim", s[9])?,
+                current_smooth: positive_setting(Self::NAME, "I_s", s[10])?,
             },
         })
     }
@@ -322,6 +333,7 @@ impl PhysicsTerm for Law {
             self.shapes.fade,
             self.shapes.instant,
             self.shapes.speed_limit,
+            self.shapes.current_smooth,
         ]
     }
 
