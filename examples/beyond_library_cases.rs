@@ -34,7 +34,10 @@
 //! `load_mass_change`, `speed_clip`, `sensor_gain_heat`, `brush_bounce`; a sixteenth (session
 //! 32, made after the heat and the speed's range in what is read and the supply's knocks were
 //! written, to judge them blind), `bearing_heat_drag`, `current_deadband`,
-//! `tacho_heat_offset`, `current_skew`.
+//! `tacho_heat_offset`, `current_skew`; a seventeenth (session 33, made after the current's
+//! sign in what is read of I, the heat in what is read of ω and the drag growing with the heat
+//! were written, to judge them blind), `bus_sag`, `hall_compression`, `grease_thinning`,
+//! `load_side_encoder`.
 //!
 //! cargo run --release --example beyond_library_cases -- [--out DIR] [--per-effect 3]
 //!     [--seed-base 510000] [--min-nats 20] [--max-nats 300] [--effects a,b,…] [--volts 24]
@@ -315,6 +318,19 @@ enum Effect {
     /// A multiplexed converter that samples the current τ before the speed and stamps both
     /// at the speed's instant: what is read of I is I(t − τ). `--effects current_skew`.
     CurrentSkew { tau: f64 },
+    /// A battery's internal resistance r_b behind the bridge: the bus sags by r_b times the
+    /// current it delivers, U·I/V_0 (V_0 = 30 V at 24), and the winding sees U·V_bus/V_0,
+    /// U − r_b·U²·I/V_0². On a constant input that is a resistance. `--effects bus_sag`.
+    BusSag { r_b: f64 },
+    /// A Hall current sensor whose core compresses at high current: it reads I − a·I³.
+    /// `--effects hall_compression`.
+    HallCompression { a: f64 },
+    /// A seal's viscous drag that thins as the motor warms: a torque a·ω·exp(−E/100 J),
+    /// E = ∫R·I²dt. `--effects grease_thinning`.
+    GreaseThinning { a: f64 },
+    /// The speed read by an encoder on the load's side of a compliant coupling (the coupling
+    /// of `compliant_coupling`, the load's speed read). `--effects load_side_encoder`.
+    LoadSideEncoder { share: f64, f: f64, zeta: f64 },
 }
 
 /// splitmix64's finalizer: the draws below of a case's salt and a sample's or a window's index.
@@ -585,6 +601,14 @@ impl Effect {
             "current_deadband" => Effect::CurrentDeadband { i_d: 1.0 },
             "tacho_heat_offset" => Effect::TachoHeatOffset { b: 0.1 },
             "current_skew" => Effect::CurrentSkew { tau: 1e-4 },
+            "bus_sag" => Effect::BusSag { r_b: 0.01 },
+            "hall_compression" => Effect::HallCompression { a: 1e-7 },
+            "grease_thinning" => Effect::GreaseThinning { a: 1e-5 },
+            "load_side_encoder" => Effect::LoadSideEncoder {
+                share: rng.random_range(0.3..0.7),
+                f: 200.0,
+                zeta: rng.random_range(0.05..0.2),
+            },
             other => panic!("unknown effect {other}; known: {:?}", Effect::NAMES),
         }
     }
@@ -660,6 +684,10 @@ impl Effect {
             Effect::CurrentDeadband { i_d } => i_d,
             Effect::TachoHeatOffset { b } => b,
             Effect::CurrentSkew { tau } => tau,
+            Effect::BusSag { r_b } => r_b,
+            Effect::HallCompression { a } => a,
+            Effect::GreaseThinning { a } => a,
+            Effect::LoadSideEncoder { f, .. } => 1.0 / f,
         }
     }
 
@@ -733,6 +761,10 @@ impl Effect {
             Effect::CurrentDeadband { i_d } => *i_d = s,
             Effect::TachoHeatOffset { b } => *b = s,
             Effect::CurrentSkew { tau } => *tau = s,
+            Effect::BusSag { r_b } => *r_b = s,
+            Effect::HallCompression { a } => *a = s,
+            Effect::GreaseThinning { a } => *a = s,
+            Effect::LoadSideEncoder { f, .. } => *f = 1.0 / s,
         }
         e
     }
@@ -743,6 +775,7 @@ impl Effect {
         match self {
             Effect::ResonantSensor { .. }
             | Effect::CompliantCoupling { .. }
+            | Effect::LoadSideEncoder { .. }
             | Effect::CurrentSensorResonance { .. } => 1.0 / 60.0,
             Effect::InputDelay { .. } | Effect::SensorLag { .. } => 0.02,
             Effect::SaggingSupply { .. } => 0.5 / 60.0,
@@ -815,6 +848,11 @@ impl Effect {
             Effect::CurrentDeadband { .. } => 50.0,
             Effect::TachoHeatOffset { .. } => 10.0,
             Effect::CurrentSkew { .. } => 2e-3,
+            // A battery of at most 1 Ω; a core that compresses by at most 30% at 300 A; a drag
+            // of at most 0.5 N·m at 1000 rad/s.
+            Effect::BusSag { .. } => 1.0,
+            Effect::HallCompression { .. } => 0.3 / 9e4,
+            Effect::GreaseThinning { .. } => 5e-4,
             _ => 1.0,
         }
     }
@@ -888,7 +926,10 @@ fn rhs(
         }
         Some(&Effect::InputDelay { tau }) => u = input.at(t - tau, times),
         Some(&Effect::SensorLag { tau, channel }) => dx[2] = (x[channel] - x[2]) / tau,
-        Some(&Effect::CompliantCoupling { share, f, zeta }) => {
+        Some(
+            &Effect::CompliantCoupling { share, f, zeta }
+            | &Effect::LoadSideEncoder { share, f, zeta },
+        ) => {
             // Motor side (1 − s)J, load side sJ; spring k and damper c from the resonance of the
             // two masses: ω_r² = k·(1/J_m + 1/J_l).
             let (jm, jl) = ((1.0 - share) * m.j, share * m.j);
@@ -1046,6 +1087,14 @@ fn rhs(
             torque -= a * x[2] * w.tanh();
             dx[2] = m.r * i * i;
         }
+        Some(&Effect::BusSag { r_b }) => {
+            let v0 = 30.0 / 24.0 * input.level;
+            u -= r_b * u * u * i / (v0 * v0);
+        }
+        Some(&Effect::GreaseThinning { a }) => {
+            torque -= a * w * (-x[2] / 100.0).exp();
+            dx[2] = m.r * i * i;
+        }
         Some(&Effect::BrushBounce { d, salt }) => {
             let window = 0.025;
             if t >= 0.0 {
@@ -1078,7 +1127,8 @@ fn rhs(
             | Effect::SpeedRangeSwitch { .. }
             | Effect::SpeedClip { .. }
             | Effect::CurrentDeadband { .. }
-            | Effect::CurrentSkew { .. },
+            | Effect::CurrentSkew { .. }
+            | Effect::HallCompression { .. },
         )
         // Their balances are rewritten below.
         | Some(Effect::MountResonance { .. } | Effect::ShortedTurn { .. })
@@ -1087,7 +1137,11 @@ fn rhs(
     // With a coupling, the viscous loss acts on the load side.
     let d_motor = if matches!(
         e,
-        Some(Effect::CompliantCoupling { .. } | Effect::Backlash { .. })
+        Some(
+            Effect::CompliantCoupling { .. }
+                | Effect::LoadSideEncoder { .. }
+                | Effect::Backlash { .. }
+        )
     ) {
         0.0
     } else {
@@ -1145,6 +1199,8 @@ fn measured(e: Option<&Effect>, x: &[f64; 4]) -> [f64; 2] {
         Some(&Effect::AsymmetricTacho { eps }) => [x[0], x[1] + eps * x[1].abs()],
         Some(&Effect::SensorGainHeat { beta }) => [x[0] * (1.0 + beta * x[2]), x[1]],
         Some(&Effect::TachoHeatOffset { b }) => [x[0], x[1] + b * x[2]],
+        Some(&Effect::HallCompression { a }) => [x[0] - a * x[0].powi(3), x[1]],
+        Some(Effect::LoadSideEncoder { .. }) => [x[0], x[3]],
         Some(&Effect::CurrentDeadband { i_d }) => {
             [x[0].signum() * (x[0].abs() - i_d).max(0.0), x[1]]
         }
@@ -1492,6 +1548,14 @@ fn expected(e: &Effect, input_level: f64) -> String {
         Effect::TachoHeatOffset { .. } => r#"{"kind": "drift", "variable": "heat", "balance": "measurement:omega"}"#.into(),
         // The current alone late by τ: a lag of I (a first-order filter of τ lags by τ).
         Effect::CurrentSkew { tau } => format!(r#"{{"kind": "lag", "channel": "I", "seconds": {tau}}}"#),
+        // The voltage lost in the current's direction, growing with the input's square.
+        Effect::BusSag { .. } => r#"{"kind": "state", "balance": "voltage"}"#.into(),
+        // What is read of I, a function of I.
+        Effect::HallCompression { .. } => r#"{"kind": "state", "balance": "measurement:I"}"#.into(),
+        // A viscous drag fading with the heat: a drift with the heat, of the torque balance.
+        Effect::GreaseThinning { .. } => r#"{"kind": "drift", "variable": "heat", "balance": "torque"}"#.into(),
+        // The load rings at the two-mass resonance, damped, and its speed is read.
+        Effect::LoadSideEncoder { f, zeta, .. } => format!(r#"{{"kind": "oscillation", "frequency_hz": {}, "damping_ratio": {zeta}, "channel": "omega", "ringing": true}}"#, f * (1.0 - zeta * zeta).sqrt()),
         // The flux's ripple in both balances (as flux_saturation's): the kind, the angle and
         // the order are asked.
         Effect::CommutatorRipple { k, .. } => format!(r#"{{"kind": "state", "functions": ["omega*sin(k*theta)", "omega*cos(k*theta)", "I*sin(k*theta)", "I*cos(k*theta)"], "k": {k}}}"#),
