@@ -3,7 +3,8 @@
 //! range. Session 31's build named the first a law in I and a fade, or `unknown`, and the
 //! second a step in time of what is read of ω. Fixtures: `beyond_library_cases` of session 31's
 //! generator (seeds 920007, 920010), a set made before either function was offered there, and
-//! in view when they were.
+//! in view when they were; and a current sensor's dead band (seed 930006 of session 32's
+//! sixteenth set, made blind for the first two and in view when the current's sign was offered).
 
 mod beyond;
 
@@ -89,5 +90,44 @@ fn a_speed_sensor_clipped_at_its_range_reads_the_speed_beyond_a_limit() {
         (hinge.coefficient + 1.0).abs() < 0.2,
         "{}",
         hinge.coefficient
+    );
+}
+
+/// A Hall current sensor with a dead band: it reads sign(I)·max(|I| − I_d, 0) (I_d 2.2 A here,
+/// a 300-nat miss on an input that steps down and reverses, where the band's offset changes
+/// sign with the current). Session 32's build named it `unknown` beside the library's torque
+/// constant and a law of the torque balance. The model as given's fingerprint is now a state
+/// of what is read of I in the current's sign alone, and the law discovered is that function,
+/// its coefficient within 20% of −I_d (the sign smoothed over 1 A takes a little more than the
+/// band where the current is large, to make up for the samples near zero).
+#[test]
+fn a_current_sensor_s_dead_band_is_read_as_the_current_s_sign() {
+    let (problem, answer) = fixture("current_deadband-930006");
+    let i_d = truth_value(&answer, "i_d");
+    let d = whole_library(&problem);
+    let given = d
+        .unexplained_as_given
+        .expect("a 300-nat miss is not nothing");
+    let Fingerprint::State {
+        balance, functions, ..
+    } = &given.fingerprint
+    else {
+        panic!("{:?}", given.fingerprint)
+    };
+    assert_eq!(balance, "measurement:I");
+    let names: Vec<&str> = functions.iter().map(|f| f.name.as_str()).collect();
+    assert_eq!(names, vec!["sign(I)"]);
+    let law = d.discovered.expect("the dead band's law");
+    assert_eq!(law.balance, "measurement:I");
+    let sign = law
+        .functions
+        .iter()
+        .find(|f| f.name == "sign(I)")
+        .expect("the current's sign in the law");
+    assert!(
+        (sign.coefficient / -i_d - 1.0).abs() < 0.2,
+        "sign(I)'s coefficient {} against the truth's −I_d {}",
+        sign.coefficient,
+        -i_d
     );
 }

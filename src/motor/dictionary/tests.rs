@@ -279,3 +279,38 @@ fn a_fade_is_one_at_the_start_and_one_over_e_after_its_time_constant() {
     assert_eq!(FUNCTIONS[FADE], "exp(-t/tau)");
     assert_eq!(pretty(FUNCTIONS[FADE]), "exp(-t/τ)");
 }
+
+/// The current's sign, smoothed over I_s as the library's voltage drop smooths it (tanh), read
+/// of I only; the speed's sign times the heat, a drag of the torque balance only, reading the
+/// law's heat state.
+#[test]
+fn the_current_s_sign_is_read_of_i_and_the_speed_s_sign_times_the_heat_drags_the_torque() {
+    let at = |current: f64, speed: f64| Point {
+        t: 0.0,
+        current,
+        speed,
+        voltage: 0.0,
+        charge: 0.0,
+        heat: 40.0,
+        theta: 0.0,
+    };
+    let s = Shapes {
+        current_smooth: 2.0,
+        ..shapes()
+    };
+    assert!((value(SIGN_I, &at(3.0, 0.0), &s) - 1.5f64.tanh()).abs() < 1e-15);
+    assert_eq!(value(SIGN_I, &at(-300.0, 0.0), &s), -1.0);
+    assert_eq!(value(SIGN_OMEGA_HEAT, &at(0.0, -500.0), &s), -40.0);
+    assert_eq!(value(SIGN_OMEGA_HEAT, &at(0.0, 0.0), &s), 0.0);
+    assert_eq!(state_of(SIGN_OMEGA_HEAT), Some(1));
+    assert_eq!(state_of(SIGN_I), None);
+    let offered =
+        |f: usize| -> Vec<bool> { (0..BALANCES.len()).map(|b| offered_in(f, b)).collect() };
+    assert_eq!(offered(SIGN_I), vec![false, false, true, false]);
+    assert_eq!(offered(SIGN_OMEGA_HEAT), vec![true, false, false, false]);
+    assert_eq!(
+        index_of("measurement:I:sign(I)"),
+        Ok(2 * N_FUNCTIONS + SIGN_I)
+    );
+    assert_eq!(index_of("torque:sign(omega)*heat"), Ok(SIGN_OMEGA_HEAT));
+}
