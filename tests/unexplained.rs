@@ -559,7 +559,9 @@ fn a_lag_standing_in_for_a_jittered_clock_leaves_the_jitter_reported() {
 /// said "state", the dips' frequency hidden behind it. What the model lacks beyond the
 /// library is the periodic part: the fingerprint of the model as given is now the oscillation
 /// left after the library's selection, at the dips' frequency within 15%, running on whatever
-/// the input does, and the law heads its alternatives.
+/// the input does, and a law heads its alternatives: a state, or since the heat is offered in
+/// what is read of ω (session 33) a drift with the heat there, the two within 0.2 nats of each
+/// other (62.25 and 62.09) as either holds the mean's slow rise.
 #[test]
 fn a_supply_s_periodic_dips_are_named_by_their_frequency_beyond_the_term_that_holds_their_mean() {
     let (problem, answer) = fixture("supply_dips-820010");
@@ -580,7 +582,10 @@ fn a_supply_s_periodic_dips_are_named_by_their_frequency_beyond_the_term_that_ho
         other => panic!("{other:?}"),
     }
     assert!(
-        matches!(given.alternatives[0], Fingerprint::State { .. }),
+        matches!(
+            given.alternatives[0],
+            Fingerprint::State { .. } | Fingerprint::Drift { .. }
+        ),
         "{:?}",
         given.alternatives
     );
